@@ -1,0 +1,55 @@
+//! Node classes (SPEC §3).
+
+/// The class of a contact node on a smooth piece.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[repr(u8)]
+pub enum Class {
+    /// No contact: `λν = λt = 0`, guard `dν < 0`.
+    Open = 0,
+    /// Contact, stick: `dν = dt = 0`, guards `λν < 0`, `F λν < λt < −F λν`.
+    Stick = 1,
+    /// Contact, slip in +t: `dν = 0`, `λt = F λν`, guards `λν < 0`, `dt > 0`.
+    SlipPlus = 2,
+    /// Contact, slip in −t: `dν = 0`, `λt = −F λν`, guards `λν < 0`, `dt < 0`.
+    SlipMinus = 3,
+}
+
+impl Class {
+    /// All four classes, in the order of their discriminants.
+    pub const ALL: [Class; 4] = [Class::Open, Class::Stick, Class::SlipPlus, Class::SlipMinus];
+
+    /// The exchange-format name: `"open"`, `"stick"`, `"slip+"`, `"slip-"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Class::Open => "open",
+            Class::Stick => "stick",
+            Class::SlipPlus => "slip+",
+            Class::SlipMinus => "slip-",
+        }
+    }
+
+    /// The seed paper's words: "no contact", "contact, stick", "contact, slip".
+    pub fn words(self) -> &'static str {
+        match self {
+            Class::Open => "no contact",
+            Class::Stick => "contact, stick",
+            Class::SlipPlus | Class::SlipMinus => "contact, slip",
+        }
+    }
+
+    /// Parses the exchange-format name.
+    pub fn from_name(s: &str) -> Option<Class> {
+        Class::ALL.into_iter().find(|c| c.name() == s)
+    }
+
+    /// True for the three contact classes.
+    pub fn in_contact(self) -> bool {
+        self != Class::Open
+    }
+}
+
+impl std::fmt::Display for Class {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}

@@ -1,0 +1,63 @@
+//! Errors of the library. Every way the data or a computation can fail has a variant
+//! with a specific message; nothing in the library panics on bad data.
+
+/// Result alias used throughout the crate.
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Everything that can go wrong. The `Display` text is a complete one-line message.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A dimension does not fit (`what` names the object).
+    #[error("dimension mismatch: {0}")]
+    Dimension(String),
+    /// A CSR matrix is malformed (row pointers, column indices, index base).
+    #[error("{0}")]
+    Csr(String),
+    /// A NaN or infinite value in the input.
+    #[error("non-finite value: {0}")]
+    NonFinite(String),
+    /// The stiffness matrix is not symmetric (full storage given).
+    #[error("A is not symmetric: {0}")]
+    NotSymmetric(String),
+    /// The Cholesky factorisation of A met a non-positive pivot.
+    #[error("A is not positive definite: non-positive pivot at (0-based) position {pivot} of the fill-reducing ordering, original row {row}")]
+    NotSpd {
+        /// Pivot position in the permuted order.
+        pivot: usize,
+        /// Row of A (0-based) that the pivot belongs to.
+        row: usize,
+    },
+    /// B = [N; T] does not have full row rank: W is not positive definite.
+    #[error("B = [N; T] is rank-deficient (W = B A^-1 B^T not positive definite): {0}")]
+    RankDeficient(String),
+    /// A parameter is out of its range (friction < 0, r ≤ 0, empty window, …).
+    #[error("invalid parameter: {0}")]
+    InvalidParameter(String),
+    /// The load callback failed (returned a nonzero code) or returned NaN/Inf.
+    #[error("load callback failed at alpha = {alpha:e} (code {code}): {message}")]
+    Load {
+        /// α at which the load was evaluated.
+        alpha: f64,
+        /// The callback's own nonzero return code (0 when it returned non-finite values).
+        code: i32,
+        /// What went wrong.
+        message: String,
+    },
+    /// The fixed-α solver did not converge.
+    #[error("fixed-alpha solve failed at alpha = {alpha:e}: {message}")]
+    SolveFailed {
+        /// α of the solve.
+        alpha: f64,
+        /// Why.
+        message: String,
+    },
+    /// A numerical failure during tracing (singular piece where none may be, …).
+    #[error("numerical failure: {0}")]
+    Numerical(String),
+    /// A call made in the wrong order (e.g. stepping a path that was not started).
+    #[error("usage: {0}")]
+    Usage(String),
+    /// Reading or writing a file failed (CLI, exchange format).
+    #[error("{0}")]
+    Io(String),
+}

@@ -1,0 +1,616 @@
+//! Problem data (SPEC §1): the stiffness `A`, the contact matrices `N`, `T`, friction `F`,
+//! gap `g` and the augmentation parameter `r`, validated once and immutable afterwards.
+//!
+//! A [`Problem`] owns the Cholesky factor of `A` and the Delassus operator `W` (see
+//! [`crate::condense`]); it is `Send + Sync` and is meant to be shared (`Arc<Problem>`) by
+//! any number of [`crate::path::Path`]s.
+
+use crate::condense::Delassus;
+use crate::error::{Error, Result};
+
+/// A sparse matrix in compressed sparse row form, 0-based, validated: row pointers start
+/// at 0 and do not decrease, column indices are in range, sorted and unique within each
+/// row, values are finite.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CsrMatrix {
+    nrows: usize,
+    ncols: usize,
+    row_ptr: Vec<usize>,
+    col_idx: Vec<usize>,
+    values: Vec<f64>,
+}
+
+impl CsrMatrix {
+    /// Validates and copies a CSR matrix given with signed 64-bit indices and an index base
+    /// of 0 (C) or 1 (Fortran, MATLAB).
+    ///
+    /// `row_ptr` has `nrows + 1` entries with `row_ptr[0] == index_base`; the entries of row
+    /// `i` are `row_ptr[i] - base .. row_ptr[i+1] - base`. Within a row, columns may come in
+    /// any order (they are sorted here) but must not repeat: **duplicate entries are
+    /// rejected**, not summed, because a duplicate in assembled CSR is almost always a bug in
+    /// the caller's assembly. `name` is used in error messages ("A", "N", "T").
+    ///
+    /// Errors: [`Error::Csr`] for a bad index base, row pointer (length, start, decrease,
+    /// end ≠ number of values), column index out of range, duplicate; [`Error::NonFinite`]
+    /// for a NaN or infinite value.
+    pub fn from_raw(
+        name: &str,
+        nrows: usize,
+        ncols: usize,
+        row_ptr: &[i64],
+        col_idx: &[i64],
+        values: &[f64],
+        index_base: i64,
+    ) -> Result<Self> {
+        if index_base != 0 && index_base != 1 {
+            return Err(Error::Csr(format!(
+                "{name} (CSR): index_base is {index_base}, must be 0 or 1"
+            )));
+        }
+        if row_ptr.len() != nrows + 1 {
+            return Err(Error::Csr(format!(
+                "{name} (CSR): row_ptr has {} entries, expected nrows + 1 = {}",
+                row_ptr.len(),
+                nrows + 1
+            )));
+        }
+        if col_idx.len() != values.len() {
+            return Err(Error::Csr(format!(
+                "{name} (CSR): {} column indices but {} values",
+                col_idx.len(),
+                values.len()
+            )));
+        }
+        if row_ptr[0] != index_base {
+            return Err(Error::Csr(format!(
+                "{name} (CSR): row_ptr[0] = {}, expected the index base {index_base}",
+                row_ptr[0]
+            )));
+        }
+        let nnz = values.len();
+        let mut rp = Vec::with_capacity(nrows + 1);
+        for (i, &r) in row_ptr.iter().enumerate() {
+            let r0 = r - index_base;
+            if i > 0 && r < row_ptr[i - 1] {
+                return Err(Error::Csr(format!(
+                    "{name} (CSR): row pointer decreases at row {} ({} after {})",
+                    i - 1 + index_base as usize,
+                    r,
+                    row_ptr[i - 1]
+                )));
+            }
+            if r0 < 0 || r0 as u64 > nnz as u64 {
+                return Err(Error::Csr(format!(
+                    "{name} (CSR): row_ptr[{i}] = {r} is outside 0..={nnz} (+ index base)"
+                )));
+            }
+            rp.push(r0 as usize);
+        }
+        if rp[nrows] != nnz {
+            return Err(Error::Csr(format!(
+                "{name} (CSR): row_ptr[nrows] - base = {} but there are {nnz} values",
+                rp[nrows]
+            )));
+        }
+        let mut ci = Vec::with_capacity(nnz);
+        let mut vals = Vec::with_capacity(nnz);
+        let mut row: Vec<(usize, f64)> = Vec::new();
+        for i in 0..nrows {
+            row.clear();
+            for k in rp[i]..rp[i + 1] {
+                let c = col_idx[k] - index_base;
+                if c < 0 || c as u64 >= ncols as u64 {
+                    return Err(Error::Csr(format!(
+                        "{name} (CSR): row {} has column index {} outside {}..{} (ncols {ncols}, index base {index_base})",
+                        i as i64 + index_base,
+                        col_idx[k],
+                        index_base,
+                        ncols as i64 + index_base
+                    )));
+                }
+                if !values[k].is_finite() {
+                    return Err(Error::NonFinite(format!(
+                        "{name}: entry ({}, {}) is {}",
+                        i as i64 + index_base,
+                        col_idx[k],
+                        values[k]
+                    )));
+                }
+                row.push((c as usize, values[k]));
+            }
+            row.sort_by_key(|e| e.0);
+            for w in row.windows(2) {
+                if w[0].0 == w[1].0 {
+                    return Err(Error::Csr(format!(
+                        "{name} (CSR): row {} has a duplicate entry in column {} (duplicates are rejected, not summed)",
+                        i as i64 + index_base,
+                        w[0].0 as i64 + index_base
+                    )));
+                }
+            }
+            for &(c, v) in &row {
+                ci.push(c);
+                vals.push(v);
+            }
+        }
+        Ok(Self {
+            nrows,
+            ncols,
+            row_ptr: rp,
+            col_idx: ci,
+            values: vals,
+        })
+    }
+
+    /// Builds a CSR matrix from 0-based triplets `(row, col, value)`; duplicates are
+    /// **summed** here (this is the assembly entry point, as in Matrix Market files).
+    /// Errors: indices out of range, non-finite values.
+    pub fn from_triplets(
+        name: &str,
+        nrows: usize,
+        ncols: usize,
+        triplets: &[(usize, usize, f64)],
+    ) -> Result<Self> {
+        let mut t: Vec<(usize, usize, f64)> = triplets.to_vec();
+        for &(i, j, v) in &t {
+            if i >= nrows || j >= ncols {
+                return Err(Error::Csr(format!(
+                    "{name}: entry ({}, {}) (1-based) outside a {nrows}x{ncols} matrix",
+                    i + 1,
+                    j + 1
+                )));
+            }
+            if !v.is_finite() {
+                return Err(Error::NonFinite(format!(
+                    "{name}: entry ({}, {}) (1-based) is {v}",
+                    i + 1,
+                    j + 1
+                )));
+            }
+        }
+        t.sort_by_key(|e| (e.0, e.1));
+        let mut row_ptr = vec![0usize; nrows + 1];
+        let mut col_idx = Vec::with_capacity(t.len());
+        let mut values: Vec<f64> = Vec::with_capacity(t.len());
+        let mut last: Option<(usize, usize)> = None;
+        for (i, j, v) in t {
+            if last == Some((i, j)) {
+                *values.last_mut().unwrap() += v;
+            } else {
+                col_idx.push(j);
+                values.push(v);
+                row_ptr[i + 1] += 1;
+                last = Some((i, j));
+            }
+        }
+        for i in 0..nrows {
+            row_ptr[i + 1] += row_ptr[i];
+        }
+        Ok(Self {
+            nrows,
+            ncols,
+            row_ptr,
+            col_idx,
+            values,
+        })
+    }
+
+    /// Builds a CSR matrix from a dense row-major array, dropping exact zeros
+    /// (convenient for tests and tiny problems).
+    pub fn from_dense(nrows: usize, ncols: usize, row_major: &[f64]) -> Result<Self> {
+        if row_major.len() != nrows * ncols {
+            return Err(Error::Dimension(format!(
+                "dense array has {} entries, expected {nrows}x{ncols}",
+                row_major.len()
+            )));
+        }
+        let mut t = Vec::new();
+        for i in 0..nrows {
+            for j in 0..ncols {
+                let v = row_major[i * ncols + j];
+                if v != 0.0 {
+                    t.push((i, j, v));
+                }
+            }
+        }
+        Self::from_triplets("matrix", nrows, ncols, &t)
+    }
+
+    /// Number of rows.
+    pub fn nrows(&self) -> usize {
+        self.nrows
+    }
+    /// Number of columns.
+    pub fn ncols(&self) -> usize {
+        self.ncols
+    }
+    /// Number of stored entries.
+    pub fn nnz(&self) -> usize {
+        self.values.len()
+    }
+    /// Row pointers (0-based, `nrows + 1` entries).
+    pub fn row_ptr(&self) -> &[usize] {
+        &self.row_ptr
+    }
+    /// Column indices (0-based, sorted within each row).
+    pub fn col_idx(&self) -> &[usize] {
+        &self.col_idx
+    }
+    /// Values.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+    /// The entries of row `i` as `(column, value)` pairs.
+    pub fn row(&self, i: usize) -> impl Iterator<Item = (usize, f64)> + '_ {
+        let r = self.row_ptr[i]..self.row_ptr[i + 1];
+        self.col_idx[r.clone()]
+            .iter()
+            .copied()
+            .zip(self.values[r].iter().copied())
+    }
+    /// `y = M x`.
+    pub fn mul_vec(&self, x: &[f64], y: &mut [f64]) {
+        for (i, yi) in y.iter_mut().enumerate().take(self.nrows) {
+            *yi = self.row(i).map(|(j, v)| v * x[j]).sum();
+        }
+    }
+    /// `y += Mᵀ x`.
+    pub fn mul_t_vec_add(&self, x: &[f64], y: &mut [f64]) {
+        for (i, &xi) in x.iter().enumerate().take(self.nrows) {
+            if xi != 0.0 {
+                for (j, v) in self.row(i) {
+                    y[j] += v * xi;
+                }
+            }
+        }
+    }
+    /// Largest absolute entry (0 for an empty matrix).
+    pub fn max_abs(&self) -> f64 {
+        self.values.iter().fold(0.0, |m, v| m.max(v.abs()))
+    }
+}
+
+/// Which part of the symmetric matrix `A` the caller stores.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Storage {
+    /// Both triangles; symmetry is checked to a relative tolerance of 1e-10.
+    Full,
+    /// Only entries with `row ≥ col` (entries above the diagonal are an error).
+    Lower,
+    /// Only entries with `row ≤ col` (entries below the diagonal are an error).
+    Upper,
+}
+
+/// Builder for a [`Problem`]. Every setter only records; [`ProblemBuilder::build`]
+/// validates everything and factorises.
+#[derive(Debug, Clone)]
+pub struct ProblemBuilder {
+    a: CsrMatrix,
+    storage: Storage,
+    n: CsrMatrix,
+    t: CsrMatrix,
+    friction: Vec<f64>,
+    gap: Option<Vec<f64>>,
+    r: Option<f64>,
+}
+
+impl ProblemBuilder {
+    /// Starts a problem from the stiffness `A` (n×n, symmetric positive definite, Dirichlet
+    /// dofs eliminated, stored as `storage` says) and the contact matrices `N`, `T` (p×n:
+    /// row i gives the outward normal and the tangential displacement of contact node i).
+    /// Friction defaults to 0 (frictionless), the gap to 0, `r` to the default of
+    /// [`Problem::default_r`].
+    pub fn new(a: CsrMatrix, storage: Storage, n: CsrMatrix, t: CsrMatrix) -> Self {
+        Self {
+            a,
+            storage,
+            n,
+            t,
+            friction: vec![0.0],
+            gap: None,
+            r: None,
+        }
+    }
+    /// Friction coefficient `F ≥ 0` (dimensionless), the same at every node.
+    pub fn friction_uniform(mut self, f: f64) -> Self {
+        self.friction = vec![f];
+        self
+    }
+    /// Friction coefficients per node (`p` values, each `≥ 0`).
+    pub fn friction(mut self, f: Vec<f64>) -> Self {
+        self.friction = f;
+        self
+    }
+    /// Initial normal gap `g` (p values, length units of `u`): contact means `(N u)_i = g_i`.
+    pub fn gap(mut self, g: Vec<f64>) -> Self {
+        self.gap = Some(g);
+        self
+    }
+    /// Augmentation parameter `r > 0` (force per length). Solutions and transition points
+    /// do not depend on it; it only scales the rows of `H` and so the residuals.
+    pub fn r(mut self, r: f64) -> Self {
+        self.r = Some(r);
+        self
+    }
+
+    /// Validates the data, factorises `A` (sparse Cholesky, fill-reducing ordering) and
+    /// forms `W = B A⁻¹ Bᵀ`.
+    ///
+    /// Errors: [`Error::Dimension`] (A not square, N/T not p×n, F or g of wrong length),
+    /// [`Error::NotSymmetric`], [`Error::Csr`] (entries in the wrong triangle),
+    /// [`Error::NonFinite`], [`Error::NotSpd`] (with the pivot), [`Error::RankDeficient`]
+    /// (B = [N; T] without full row rank 2p), [`Error::InvalidParameter`] (F < 0 or not
+    /// finite, r ≤ 0 or not finite, p = 0).
+    pub fn build(self) -> Result<Problem> {
+        let n = self.a.nrows();
+        if self.a.ncols() != n {
+            return Err(Error::Dimension(format!(
+                "A is {}x{}, must be square",
+                n,
+                self.a.ncols()
+            )));
+        }
+        let p = self.n.nrows();
+        if p == 0 {
+            return Err(Error::InvalidParameter(
+                "no contact nodes: N has 0 rows (p must be ≥ 1)".into(),
+            ));
+        }
+        for (name, m) in [("N", &self.n), ("T", &self.t)] {
+            if m.nrows() != p || m.ncols() != n {
+                return Err(Error::Dimension(format!(
+                    "{name} is {}x{}, expected p x n = {p}x{n} (p from the rows of N, n from A)",
+                    m.nrows(),
+                    m.ncols()
+                )));
+            }
+        }
+        if 2 * p > n {
+            return Err(Error::RankDeficient(format!(
+                "2p = {} exceeds n = {n}, so B = [N; T] cannot have full row rank",
+                2 * p
+            )));
+        }
+        let friction = match self.friction.len() {
+            1 => vec![self.friction[0]; p],
+            l if l == p => self.friction,
+            l => {
+                return Err(Error::Dimension(format!(
+                    "friction has {l} values, expected 1 or p = {p}"
+                )));
+            }
+        };
+        for (i, &f) in friction.iter().enumerate() {
+            if !f.is_finite() || f < 0.0 {
+                return Err(Error::InvalidParameter(format!(
+                    "friction coefficient F at node {} is {f}, must be finite and ≥ 0",
+                    i + 1
+                )));
+            }
+        }
+        let gap = match self.gap {
+            None => vec![0.0; p],
+            Some(g) if g.len() == p => g,
+            Some(g) => {
+                return Err(Error::Dimension(format!(
+                    "gap has {} values, expected p = {p}",
+                    g.len()
+                )));
+            }
+        };
+        if let Some(i) = gap.iter().position(|g| !g.is_finite()) {
+            return Err(Error::NonFinite(format!(
+                "gap at node {} is {}",
+                i + 1,
+                gap[i]
+            )));
+        }
+        if let Some(r) = self.r
+            && (!r.is_finite() || r <= 0.0)
+        {
+            return Err(Error::InvalidParameter(format!(
+                "r = {r}, must be finite and > 0"
+            )));
+        }
+        let lower = lower_triangle(&self.a, self.storage)?;
+        // B = [N; T] as one CSR matrix (2p x n).
+        let mut trip = Vec::with_capacity(self.n.nnz() + self.t.nnz());
+        for i in 0..p {
+            trip.extend(self.n.row(i).map(|(j, v)| (i, j, v)));
+            trip.extend(self.t.row(i).map(|(j, v)| (p + i, j, v)));
+        }
+        let b = CsrMatrix::from_triplets("B", 2 * p, n, &trip)?;
+        let full_a = full_from_lower(&lower);
+        let delassus = std::sync::Arc::new(Delassus::new(&lower, &b)?);
+        let r_default = delassus.default_r();
+        let r = self.r.unwrap_or(r_default);
+        Ok(Problem {
+            n,
+            p,
+            a: full_a,
+            b,
+            friction,
+            gap,
+            r,
+            r_default,
+            delassus,
+        })
+    }
+}
+
+/// Lower triangle (row ≥ col) of A as CSR, checking the storage convention.
+fn lower_triangle(a: &CsrMatrix, storage: Storage) -> Result<CsrMatrix> {
+    let n = a.nrows();
+    let mut t = Vec::with_capacity(a.nnz());
+    match storage {
+        Storage::Lower | Storage::Upper => {
+            for i in 0..n {
+                for (j, v) in a.row(i) {
+                    let ok = if storage == Storage::Lower {
+                        i >= j
+                    } else {
+                        i <= j
+                    };
+                    if !ok {
+                        return Err(Error::Csr(format!(
+                            "A (CSR, {storage:?} storage): entry ({}, {}) (1-based) lies in the other triangle",
+                            i + 1,
+                            j + 1
+                        )));
+                    }
+                    t.push((i.max(j), i.min(j), v));
+                }
+            }
+        }
+        Storage::Full => {
+            let scale = a.max_abs();
+            // symmetry: compare with the transpose through a sorted triplet list
+            let mut upper: Vec<(usize, usize, f64)> = Vec::new();
+            for i in 0..n {
+                for (j, v) in a.row(i) {
+                    if i >= j {
+                        t.push((i, j, v));
+                    }
+                    if i <= j {
+                        upper.push((j, i, v));
+                    }
+                }
+            }
+            let lo = CsrMatrix::from_triplets("A", n, n, &t)?;
+            let up = CsrMatrix::from_triplets("A", n, n, &upper)?;
+            let tol = 1e-10 * scale;
+            for i in 0..n {
+                let mut x = lo.row(i).peekable();
+                let mut y = up.row(i).peekable();
+                loop {
+                    let (c, d) = match (x.peek(), y.peek()) {
+                        (None, None) => break,
+                        (Some(&(j, v)), None) => {
+                            x.next();
+                            (j, v)
+                        }
+                        (None, Some(&(j, w))) => {
+                            y.next();
+                            (j, -w)
+                        }
+                        (Some(&(j, v)), Some(&(k, w))) => {
+                            if j == k {
+                                x.next();
+                                y.next();
+                                (j, v - w)
+                            } else if j < k {
+                                x.next();
+                                (j, v)
+                            } else {
+                                y.next();
+                                (k, -w)
+                            }
+                        }
+                    };
+                    if d.abs() > tol {
+                        return Err(Error::NotSymmetric(format!(
+                            "A({}, {}) and A({}, {}) differ by {:e} (tolerance 1e-10 * max|A| = {:e}); pass lower or upper storage if only one triangle is meant",
+                            i + 1,
+                            c + 1,
+                            c + 1,
+                            i + 1,
+                            d.abs(),
+                            tol
+                        )));
+                    }
+                }
+            }
+            return Ok(lo);
+        }
+    }
+    CsrMatrix::from_triplets("A", n, n, &t)
+}
+
+fn full_from_lower(lower: &CsrMatrix) -> CsrMatrix {
+    let n = lower.nrows();
+    let mut t = Vec::with_capacity(2 * lower.nnz());
+    for i in 0..n {
+        for (j, v) in lower.row(i) {
+            t.push((i, j, v));
+            if i != j {
+                t.push((j, i, v));
+            }
+        }
+    }
+    CsrMatrix::from_triplets("A", n, n, &t).expect("indices already validated")
+}
+
+/// A validated, factorised contact problem. Immutable; share it with `Arc`.
+#[derive(Debug)]
+pub struct Problem {
+    n: usize,
+    p: usize,
+    a: CsrMatrix,
+    b: CsrMatrix,
+    friction: Vec<f64>,
+    gap: Vec<f64>,
+    r: f64,
+    r_default: f64,
+    delassus: std::sync::Arc<Delassus>,
+}
+
+impl Problem {
+    /// Number of displacement dofs `n`.
+    pub fn n(&self) -> usize {
+        self.n
+    }
+    /// Number of contact nodes `p`.
+    pub fn p(&self) -> usize {
+        self.p
+    }
+    /// The stiffness matrix, full storage.
+    pub fn a(&self) -> &CsrMatrix {
+        &self.a
+    }
+    /// `B = [N; T]` (2p×n): rows `0..p` are N, rows `p..2p` are T.
+    pub fn b(&self) -> &CsrMatrix {
+        &self.b
+    }
+    /// Friction coefficients, one per node.
+    pub fn friction(&self) -> &[f64] {
+        &self.friction
+    }
+    /// Gap, one per node.
+    pub fn gap(&self) -> &[f64] {
+        &self.gap
+    }
+    /// The augmentation parameter in use (force per length).
+    pub fn r(&self) -> f64 {
+        self.r
+    }
+    /// The data-derived default `r = 2p / trace(W)`, the reciprocal of the mean diagonal of
+    /// the Delassus operator (a contact stiffness). Also the scale by which displacement
+    /// guards are compared with force guards, so tolerances never depend on the chosen r.
+    pub fn default_r(&self) -> f64 {
+        self.r_default
+    }
+    /// The condensation (Cholesky of A, W).
+    pub fn delassus(&self) -> &Delassus {
+        &self.delassus
+    }
+    /// A copy of this problem with another `r`; the factor of A and W are shared, not
+    /// recomputed. Errors: r ≤ 0 or not finite.
+    pub fn with_r(&self, r: f64) -> Result<Problem> {
+        if !r.is_finite() || r <= 0.0 {
+            return Err(Error::InvalidParameter(format!(
+                "r = {r}, must be finite and > 0"
+            )));
+        }
+        Ok(Problem {
+            n: self.n,
+            p: self.p,
+            a: self.a.clone(),
+            b: self.b.clone(),
+            friction: self.friction.clone(),
+            gap: self.gap.clone(),
+            r,
+            r_default: self.r_default,
+            delassus: self.delassus.clone(),
+        })
+    }
+}
