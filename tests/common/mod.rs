@@ -1,0 +1,697 @@
+//! Shared helpers of the `core_*` integration tests.
+//!
+//! Everything here is **independent of the library's numerics**: the problem data are kept
+//! as dense nalgebra matrices, the Delassus operator is formed with nalgebra's Cholesky,
+//! and the brute-force solver enumerates all `4^p` class assignments, solving each
+//! piece's linear equations with nalgebra's LU. Only the library's public API is used, and
+//! only to build the problem and to read what it traced.
+#![allow(dead_code)]
+
+use std::sync::Arc;
+
+use fricont::path::State;
+use fricont::{Class, CsrMatrix, Load, Path, PathOptions, Problem, ProblemBuilder, Storage};
+use nalgebra::{DMatrix, DVector};
+
+// ---------------------------------------------------------------------------------------
+// Random numbers: xorshift64* with a fixed seed (no dependency).
+// ---------------------------------------------------------------------------------------
+
+/// xorshift64* generator.
+pub struct Rng(u64);
+
+impl Rng {
+    pub fn new(seed: u64) -> Self {
+        let mut s = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xD1B5_4A32_D192_ED03;
+        if s == 0 {
+            s = 1;
+        }
+        let mut r = Rng(s);
+        for _ in 0..8 {
+            r.next_u64();
+        }
+        r
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        let mut x = self.0;
+        x ^= x >> 12;
+        x ^= x << 25;
+        x ^= x >> 27;
+        self.0 = x;
+        x.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    /// Uniform in [0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    /// Uniform in [a, b).
+    pub fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.uniform()
+    }
+    /// Uniform integer in lo..=hi.
+    pub fn int(&mut self, lo: usize, hi: usize) -> usize {
+        lo + (self.next_u64() % (hi - lo + 1) as u64) as usize
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Problem data kept by the test.
+// ---------------------------------------------------------------------------------------
+
+/// Dense problem data with an affine load `f0 + α f1`.
+#[derive(Clone, Debug)]
+pub struct Data {
+    pub n: usize,
+    pub p: usize,
+    pub a: DMatrix<f64>,
+    pub nm: DMatrix<f64>,
+    pub tm: DMatrix<f64>,
+    pub friction: Vec<f64>,
+    pub gap: Vec<f64>,
+    pub f0: DVector<f64>,
+    pub f1: DVector<f64>,
+}
+
+fn to_csr(m: &DMatrix<f64>) -> CsrMatrix {
+    let mut rm = Vec::with_capacity(m.nrows() * m.ncols());
+    for i in 0..m.nrows() {
+        for j in 0..m.ncols() {
+            rm.push(m[(i, j)]);
+        }
+    }
+    CsrMatrix::from_dense(m.nrows(), m.ncols(), &rm).expect("test data is valid")
+}
+
+impl Data {
+    /// Data from row-major arrays.
+    #[allow(clippy::too_many_arguments)]
+    pub fn from_rows(
+        n: usize,
+        p: usize,
+        a: &[f64],
+        nm: &[f64],
+        tm: &[f64],
+        friction: Vec<f64>,
+        f0: &[f64],
+        f1: &[f64],
+    ) -> Data {
+        Data {
+            n,
+            p,
+            a: DMatrix::from_row_slice(n, n, a),
+            nm: DMatrix::from_row_slice(p, n, nm),
+            tm: DMatrix::from_row_slice(p, n, tm),
+            friction,
+            gap: vec![0.0; p],
+            f0: DVector::from_column_slice(f0),
+            f1: DVector::from_column_slice(f1),
+        }
+    }
+
+    /// A random problem: `A = M Mᵀ + (n/2) I` (exactly symmetric), dense random `N`, `T`
+    /// (full rank with probability one), friction uniform in `[fmin, fmax]` per node,
+    /// optionally a random gap, random affine load.
+    pub fn random(rng: &mut Rng, p: usize, n: usize, fmin: f64, fmax: f64, gap: bool) -> Data {
+        let m = DMatrix::from_fn(n, n, |_, _| rng.range(-1.0, 1.0));
+        let mut a = &m * m.transpose() + DMatrix::identity(n, n) * (0.5 * n as f64);
+        let at = a.transpose();
+        a = (a + at) * 0.5;
+        let nm = DMatrix::from_fn(p, n, |_, _| rng.range(-1.0, 1.0));
+        let tm = DMatrix::from_fn(p, n, |_, _| rng.range(-1.0, 1.0));
+        let friction = (0..p).map(|_| rng.range(fmin, fmax)).collect();
+        let gap = (0..p)
+            .map(|_| if gap { rng.range(-0.2, 0.2) } else { 0.0 })
+            .collect();
+        let f0 = DVector::from_fn(n, |_, _| rng.range(-1.0, 1.0));
+        let f1 = DVector::from_fn(n, |_, _| rng.range(-1.0, 1.0));
+        Data {
+            n,
+            p,
+            a,
+            nm,
+            tm,
+            friction,
+            gap,
+            f0,
+            f1,
+        }
+    }
+
+    /// The library's problem for these data (full storage, default r).
+    pub fn problem(&self) -> Problem {
+        self.builder().build().expect("valid test problem")
+    }
+
+    /// The builder for these data.
+    pub fn builder(&self) -> ProblemBuilder {
+        ProblemBuilder::new(
+            to_csr(&self.a),
+            Storage::Full,
+            to_csr(&self.nm),
+            to_csr(&self.tm),
+        )
+        .friction(self.friction.clone())
+        .gap(self.gap.clone())
+    }
+
+    pub fn affine_load(&self) -> Load {
+        Load::affine(self.f0.as_slice().to_vec(), self.f1.as_slice().to_vec()).unwrap()
+    }
+
+    /// `f(α) = f0 + φ f1`.
+    pub fn force(&self, phi: f64) -> DVector<f64> {
+        &self.f0 + &self.f1 * phi
+    }
+}
+
+/// Starts a path on `problem` with `load` at `a0`, toward `a1`, and runs it to its end.
+pub fn trace(problem: Arc<Problem>, load: Load, a0: f64, a1: f64) -> Path {
+    let mut path = Path::new(problem, load, PathOptions::window(a0, a1)).expect("Path::new");
+    path.start(a0, None).expect("start");
+    path.run().expect("run");
+    path
+}
+
+/// `(λν, λt)` of a state as one vector.
+pub fn lambda_of(s: &State) -> DVector<f64> {
+    DVector::from_iterator(
+        s.lambda_n.len() * 2,
+        s.lambda_n.iter().chain(s.lambda_t.iter()).copied(),
+    )
+}
+
+/// `|a − b| ≤ tol · max(1, |a|, |b|)`.
+pub fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * 1f64.max(a.abs()).max(b.abs())
+}
+
+pub fn vclose(a: &DVector<f64>, b: &DVector<f64>, tol: f64) -> bool {
+    let s = 1f64.max(a.amax()).max(b.amax());
+    a.len() == b.len() && (a - b).amax() <= tol * s
+}
+
+// ---------------------------------------------------------------------------------------
+// Brute force: every class assignment, each piece solved with nalgebra.
+// ---------------------------------------------------------------------------------------
+
+/// A guard `g0 + φ g1 > 0` of one node (kind: 0 = normal, 1 = tangential lower/positive
+/// side, 2 = tangential upper side; only used for reports).
+#[derive(Clone, Copy, Debug)]
+pub struct Guard {
+    pub node: usize,
+    pub g0: f64,
+    pub g1: f64,
+}
+
+/// A smooth piece in the load parameter `φ` (= α for an affine load): `λ(φ) = l0 + φ l1`,
+/// valid on the open interval `(lo, hi)` where all its guards are strictly positive.
+#[derive(Clone, Debug)]
+pub struct BrutePiece {
+    pub classes: Vec<Class>,
+    pub l0: DVector<f64>,
+    pub l1: DVector<f64>,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+impl BrutePiece {
+    pub fn lambda(&self, phi: f64) -> DVector<f64> {
+        &self.l0 + &self.l1 * phi
+    }
+}
+
+/// The condensed problem computed independently with nalgebra.
+pub struct Brute {
+    pub data: Data,
+    pub p: usize,
+    pub b: DMatrix<f64>,
+    pub w: DMatrix<f64>,
+    pub q0: DVector<f64>,
+    pub q1: DVector<f64>,
+    /// Every piece with a non-empty interval, singular pieces excluded.
+    pub pieces: Vec<BrutePiece>,
+    /// Number of class assignments with a (numerically) singular matrix.
+    pub singular: usize,
+}
+
+impl Brute {
+    pub fn new(data: &Data) -> Brute {
+        let p = data.p;
+        let n = data.n;
+        let mut b = DMatrix::zeros(2 * p, n);
+        b.rows_mut(0, p).copy_from(&data.nm);
+        b.rows_mut(p, p).copy_from(&data.tm);
+        let chol = data.a.clone().cholesky().expect("A SPD");
+        let ainv_bt = chol.solve(&b.transpose());
+        let mut w = &b * &ainv_bt;
+        let wt = w.transpose();
+        w = (w + wt) * 0.5;
+        let q0 = &b * chol.solve(&data.f0);
+        let q1 = &b * chol.solve(&data.f1);
+        let mut br = Brute {
+            data: data.clone(),
+            p,
+            b,
+            w,
+            q0,
+            q1,
+            pieces: Vec::new(),
+            singular: 0,
+        };
+        br.enumerate();
+        br
+    }
+
+    /// The displacement `u = A⁻¹ (f + Bᵀ λ)`.
+    pub fn displacement(&self, phi: f64, lambda: &DVector<f64>) -> DVector<f64> {
+        let chol = self.data.a.clone().cholesky().unwrap();
+        chol.solve(&(self.data.force(phi) + self.b.transpose() * lambda))
+    }
+
+    /// Solves the piece equations of `classes`: `M λ = r0 + φ r1`. `None` when `M` is
+    /// numerically singular.
+    pub fn piece(&self, classes: &[Class]) -> Option<(DVector<f64>, DVector<f64>)> {
+        let p = self.p;
+        let m2 = 2 * p;
+        let mut m = DMatrix::zeros(m2, m2);
+        let mut r0 = DVector::zeros(m2);
+        let mut r1 = DVector::zeros(m2);
+        for (i, &c) in classes.iter().enumerate() {
+            let f = self.data.friction[i];
+            match c {
+                Class::Open => {
+                    m[(i, i)] = 1.0;
+                    m[(p + i, p + i)] = 1.0;
+                }
+                Class::Stick => {
+                    m.row_mut(i).copy_from(&self.w.row(i));
+                    r0[i] = -(self.q0[i] - self.data.gap[i]);
+                    r1[i] = -self.q1[i];
+                    m.row_mut(p + i).copy_from(&self.w.row(p + i));
+                    r0[p + i] = -self.q0[p + i];
+                    r1[p + i] = -self.q1[p + i];
+                }
+                Class::SlipPlus | Class::SlipMinus => {
+                    m.row_mut(i).copy_from(&self.w.row(i));
+                    r0[i] = -(self.q0[i] - self.data.gap[i]);
+                    r1[i] = -self.q1[i];
+                    let s = if c == Class::SlipPlus { 1.0 } else { -1.0 };
+                    // λt − s F λν = 0
+                    m[(p + i, p + i)] = 1.0;
+                    m[(p + i, i)] = -s * f;
+                }
+            }
+        }
+        let svd = m.clone().svd(false, false);
+        let smax = svd.singular_values.max();
+        let smin = svd.singular_values.min();
+        if smin <= 1e-11 * smax {
+            return None;
+        }
+        let lu = m.lu();
+        Some((lu.solve(&r0)?, lu.solve(&r1)?))
+    }
+
+    /// `d(λ, φ) = q(φ) + W λ − (g, 0)` for `λ = l0 + φ l1`, as `(d0, d1)`.
+    fn gaps(&self, l0: &DVector<f64>, l1: &DVector<f64>) -> (DVector<f64>, DVector<f64>) {
+        let mut d0 = &self.q0 + &self.w * l0;
+        for i in 0..self.p {
+            d0[i] -= self.data.gap[i];
+        }
+        let d1 = &self.q1 + &self.w * l1;
+        (d0, d1)
+    }
+
+    /// The guards of a piece (SPEC §3 table), each `g0 + φ g1 > 0` inside.
+    pub fn guards(&self, classes: &[Class], l0: &DVector<f64>, l1: &DVector<f64>) -> Vec<Guard> {
+        let p = self.p;
+        let (d0, d1) = self.gaps(l0, l1);
+        let mut g = Vec::new();
+        for (i, &c) in classes.iter().enumerate() {
+            let f = self.data.friction[i];
+            let (ln0, ln1, lt0, lt1) = (l0[i], l1[i], l0[p + i], l1[p + i]);
+            match c {
+                Class::Open => g.push(Guard {
+                    node: i,
+                    g0: -d0[i],
+                    g1: -d1[i],
+                }),
+                Class::Stick => {
+                    g.push(Guard {
+                        node: i,
+                        g0: -ln0,
+                        g1: -ln1,
+                    });
+                    g.push(Guard {
+                        node: i,
+                        g0: lt0 - f * ln0,
+                        g1: lt1 - f * ln1,
+                    });
+                    g.push(Guard {
+                        node: i,
+                        g0: -f * ln0 - lt0,
+                        g1: -f * ln1 - lt1,
+                    });
+                }
+                Class::SlipPlus | Class::SlipMinus => {
+                    let s = if c == Class::SlipPlus { 1.0 } else { -1.0 };
+                    g.push(Guard {
+                        node: i,
+                        g0: -ln0,
+                        g1: -ln1,
+                    });
+                    g.push(Guard {
+                        node: i,
+                        g0: s * d0[p + i],
+                        g1: s * d1[p + i],
+                    });
+                }
+            }
+        }
+        g
+    }
+
+    fn enumerate(&mut self) {
+        let p = self.p;
+        let total = 4usize.pow(p as u32);
+        for code in 0..total {
+            let classes: Vec<Class> = (0..p).map(|i| Class::ALL[(code >> (2 * i)) & 3]).collect();
+            let Some((l0, l1)) = self.piece(&classes) else {
+                self.singular += 1;
+                continue;
+            };
+            let mut lo = f64::NEG_INFINITY;
+            let mut hi = f64::INFINITY;
+            let mut empty = false;
+            for gd in self.guards(&classes, &l0, &l1) {
+                if gd.g1 > 0.0 {
+                    lo = lo.max(-gd.g0 / gd.g1);
+                } else if gd.g1 < 0.0 {
+                    hi = hi.min(-gd.g0 / gd.g1);
+                } else if gd.g0 <= 0.0 {
+                    empty = true;
+                }
+            }
+            if !empty && lo < hi {
+                self.pieces.push(BrutePiece {
+                    classes,
+                    l0,
+                    l1,
+                    lo,
+                    hi,
+                });
+            }
+        }
+    }
+
+    /// All solutions at `φ` (φ strictly inside the pieces' intervals).
+    pub fn solutions_at(&self, phi: f64) -> Vec<(Vec<Class>, DVector<f64>)> {
+        self.pieces
+            .iter()
+            .filter(|pc| pc.lo < phi && phi < pc.hi)
+            .map(|pc| (pc.classes.clone(), pc.lambda(phi)))
+            .collect()
+    }
+
+    /// All interval endpoints (transition values of φ) in the open interval (a, b).
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = self
+            .pieces
+            .iter()
+            .flat_map(|pc| [pc.lo, pc.hi])
+            .filter(|x| x.is_finite())
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v
+    }
+
+    /// Independent path tracer: walks the connected component of the solution set through
+    /// the start point, from `phi0` toward `phi_end`, joining pieces at shared endpoints.
+    /// Returns `None` when the walk meets a non-generic situation (not exactly one other
+    /// piece at an endpoint, or it differs in more than one node).
+    pub fn walk(&self, phi0: f64, phi_end: f64, start: &DVector<f64>) -> Option<Walk> {
+        let (pmin, pmax) = (phi0.min(phi_end), phi0.max(phi_end));
+        let cands: Vec<usize> = (0..self.pieces.len())
+            .filter(|&k| {
+                let pc = &self.pieces[k];
+                pc.lo < phi0 && phi0 < pc.hi && vclose(&pc.lambda(phi0), start, 1e-7)
+            })
+            .collect();
+        if cands.len() != 1 {
+            return None;
+        }
+        let mut cur = cands[0];
+        let mut dir: f64 = if phi_end > phi0 { 1.0 } else { -1.0 };
+        let mut from = phi0;
+        let mut w = Walk::default();
+        let mut visited: Vec<(usize, i32)> = Vec::new();
+        for _ in 0..500 {
+            if visited.contains(&(cur, dir as i32)) {
+                w.closed = true;
+                return Some(w);
+            }
+            visited.push((cur, dir as i32));
+            let pc = &self.pieces[cur];
+            let exit = if dir > 0.0 { pc.hi } else { pc.lo };
+            if (dir > 0.0 && exit >= pmax) || (dir < 0.0 && exit <= pmin) {
+                let to = if dir > 0.0 { pmax } else { pmin };
+                w.steps.push(WalkStep {
+                    piece: cur,
+                    from,
+                    to,
+                });
+                return Some(w);
+            }
+            w.steps.push(WalkStep {
+                piece: cur,
+                from,
+                to: exit,
+            });
+            let lam = pc.lambda(exit);
+            let scale = 1f64.max(exit.abs());
+            let mut next = Vec::new();
+            for (k, q) in self.pieces.iter().enumerate() {
+                if k == cur {
+                    continue;
+                }
+                for (end, ndir) in [(q.lo, 1.0), (q.hi, -1.0)] {
+                    if (end - exit).abs() <= 1e-9 * scale && vclose(&q.lambda(exit), &lam, 1e-7) {
+                        next.push((k, ndir));
+                    }
+                }
+            }
+            if next.len() != 1 {
+                return None;
+            }
+            let (k, ndir) = next[0];
+            let diff: Vec<usize> = (0..self.p)
+                .filter(|&i| self.pieces[k].classes[i] != pc.classes[i])
+                .collect();
+            if diff.len() != 1 {
+                return None;
+            }
+            let node = diff[0];
+            w.events.push(WalkEvent {
+                phi: exit,
+                node,
+                from: pc.classes[node],
+                to: self.pieces[k].classes[node],
+                fold: ndir != dir,
+            });
+            cur = k;
+            dir = ndir;
+            from = exit;
+        }
+        None
+    }
+}
+
+/// One piece traversed by the walk, from φ = `from` to φ = `to`.
+#[derive(Clone, Debug)]
+pub struct WalkStep {
+    pub piece: usize,
+    pub from: f64,
+    pub to: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct WalkEvent {
+    pub phi: f64,
+    pub node: usize,
+    pub from: Class,
+    pub to: Class,
+    pub fold: bool,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct Walk {
+    pub steps: Vec<WalkStep>,
+    pub events: Vec<WalkEvent>,
+    pub closed: bool,
+}
+
+impl Walk {
+    /// The walk's solutions at φ: one per traversed piece whose range contains φ.
+    pub fn solutions_at(&self, br: &Brute, phi: f64) -> Vec<DVector<f64>> {
+        let mut out: Vec<DVector<f64>> = Vec::new();
+        for s in &self.steps {
+            if s.from.min(s.to) <= phi && phi <= s.from.max(s.to) {
+                let l = br.pieces[s.piece].lambda(phi);
+                if !out.iter().any(|o| vclose(o, &l, 1e-9)) {
+                    out.push(l);
+                }
+            }
+        }
+        out
+    }
+}
+
+// ---------------------------------------------------------------------------------------
+// Independent check of a reported state against the equations of SPEC §1.
+// ---------------------------------------------------------------------------------------
+
+/// Checks that `s` solves the problem at load `f` (equilibrium, Signorini, Coulomb) and is
+/// consistent with its reported classes, with relative tolerance `tol`. Returns a message
+/// on failure.
+pub fn check_state(data: &Data, f: &DVector<f64>, s: &State, tol: f64) -> Result<(), String> {
+    let p = data.p;
+    let u = DVector::from_column_slice(&s.u);
+    let ln = DVector::from_column_slice(&s.lambda_n);
+    let lt = DVector::from_column_slice(&s.lambda_t);
+    let scale_f = 1f64.max(f.amax()).max(ln.amax()).max(lt.amax());
+    let eq = &data.a * &u - f - data.nm.transpose() * &ln - data.tm.transpose() * &lt;
+    if eq.amax() > tol * scale_f * (1.0 + data.a.amax()) {
+        return Err(format!("equilibrium residual {:e}", eq.amax()));
+    }
+    let scale_u = 1f64.max(u.amax());
+    let nu = &data.nm * &u;
+    let tu = &data.tm * &u;
+    for i in 0..p {
+        let dn = nu[i] - data.gap[i];
+        let dt = tu[i];
+        let f = data.friction[i];
+        let (l, t) = (ln[i], lt[i]);
+        let et = tol * scale_f;
+        let eu = tol * scale_u;
+        match s.classes[i] {
+            Class::Open => {
+                if l.abs() > et || t.abs() > et || dn > eu {
+                    return Err(format!("node {i} open: λ = ({l}, {t}), dν = {dn}"));
+                }
+            }
+            Class::Stick => {
+                if dn.abs() > eu || dt.abs() > eu || l > et || t.abs() > -f * l + et {
+                    return Err(format!("node {i} stick: λ = ({l}, {t}), d = ({dn}, {dt})"));
+                }
+            }
+            Class::SlipPlus | Class::SlipMinus => {
+                let sg = if s.classes[i] == Class::SlipPlus {
+                    1.0
+                } else {
+                    -1.0
+                };
+                if dn.abs() > eu || l > et || (t - sg * f * l).abs() > et || sg * dt < -eu {
+                    return Err(format!(
+                        "node {i} {}: λ = ({l}, {t}), d = ({dn}, {dt})",
+                        s.classes[i]
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+// ---------------------------------------------------------------------------------------
+// A small Matrix Market / vector reader for the shared sample (independent of src/io.rs).
+// ---------------------------------------------------------------------------------------
+
+/// Reads a Matrix Market `coordinate real general|symmetric` file as 0-based triplets
+/// (a symmetric file is expanded to both triangles).
+pub fn read_mtx(path: &std::path::Path) -> (usize, usize, Vec<(usize, usize, f64)>) {
+    let text = std::fs::read_to_string(path).expect("read mtx");
+    let mut lines = text.lines();
+    let header = lines.next().expect("header").to_lowercase();
+    assert!(header.starts_with("%%matrixmarket matrix coordinate real"));
+    let symmetric = header.contains("symmetric");
+    let mut dims: Option<(usize, usize)> = None;
+    let mut t = Vec::new();
+    for l in lines {
+        let l = l.trim();
+        if l.is_empty() || l.starts_with('%') {
+            continue;
+        }
+        let w: Vec<&str> = l.split_whitespace().collect();
+        if dims.is_none() {
+            dims = Some((w[0].parse().unwrap(), w[1].parse().unwrap()));
+            continue;
+        }
+        let i: usize = w[0].parse::<usize>().unwrap() - 1;
+        let j: usize = w[1].parse::<usize>().unwrap() - 1;
+        let v: f64 = w[2].parse().unwrap();
+        t.push((i, j, v));
+        if symmetric && i != j {
+            t.push((j, i, v));
+        }
+    }
+    let (r, c) = dims.unwrap();
+    (r, c, t)
+}
+
+/// Reads a vector file (one number a line).
+pub fn read_vec(path: &std::path::Path) -> Vec<f64> {
+    std::fs::read_to_string(path)
+        .expect("read vector")
+        .split_whitespace()
+        .map(|x| x.parse().unwrap())
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------
+// Random test cases shared by several test files.
+// ---------------------------------------------------------------------------------------
+
+/// A random case: data and the α-window `[a0, a1]` (traced from a0 toward a1).
+pub struct Case {
+    pub seed: u64,
+    pub data: Data,
+    pub a0: f64,
+    pub a1: f64,
+}
+
+/// Random case number `seed`: p = 1..=5 cycling, n = 2p + 0..=3, friction small
+/// (0.05–0.3) for even seeds and up to 3 for odd seeds, a gap for every third seed,
+/// window of random length traced upward or downward.
+pub fn random_case(seed: u64) -> Case {
+    let mut rng = Rng::new(seed);
+    let p = 1 + (seed % 5) as usize;
+    let n = 2 * p + rng.int(0, 3);
+    let (fmin, fmax) = if seed % 2 == 0 {
+        (0.05, 0.3)
+    } else {
+        (0.05, 3.0)
+    };
+    let data = Data::random(&mut rng, p, n, fmin, fmax, seed % 3 == 0);
+    let lo = rng.range(-4.0, -1.0);
+    let hi = rng.range(1.0, 4.0);
+    let (a0, a1) = if seed % 4 == 3 { (hi, lo) } else { (lo, hi) };
+    Case { seed, data, a0, a1 }
+}
+
+/// `n` sample values in the window of `case`, at least `margin` away from every
+/// breakpoint of the brute force (so each sample lies inside its pieces).
+pub fn samples(case: &Case, br: &Brute, count: usize, margin: f64) -> Vec<f64> {
+    let mut rng = Rng::new(case.seed ^ 0xABCDEF);
+    let bps = br.breakpoints();
+    let (lo, hi) = (case.a0.min(case.a1), case.a0.max(case.a1));
+    let mut out = Vec::new();
+    let mut tries = 0;
+    while out.len() < count && tries < 100 * count {
+        tries += 1;
+        let a = rng.range(lo, hi);
+        if bps.iter().all(|b| (b - a).abs() > margin) {
+            out.push(a);
+        }
+    }
+    out
+}
