@@ -6,37 +6,26 @@
 //! entries 1 and 4, B with small integers), so the hand values are the exact answers.
 //! Each derivation is also cross-checked against the independent nalgebra brute force of
 //! `tests/common` where that applies.
+//!
+//! The one-node problems use `common::one_node`: n = 3 dofs, `A = diag(1, 1, 4)`,
+//! `N = [1 0 0]`, `T = [−1 1 0]`, so `A⁻¹ = diag(1, 1, 1/4)` and with
+//! `B = [[1, 0, 0], [−1, 1, 0]]`
+//!
+//! ```text
+//! W = B A⁻¹ Bᵀ = [[1, −1], [−1, 2]],    q = B A⁻¹ f = (f₁, f₂ − f₁)
+//! ```
+//!
+//! (the third dof is decoupled from the contact node and only makes n > 2p).
 
 mod common;
 
 use std::sync::Arc;
 
-use common::{Brute, Data, check_state, close, lambda_of, trace, vclose};
+use common::{Brute, Data, check_state, close, lambda_of, mirror_pair, one_node, trace, vclose};
 use fricont::{Class, EndReason};
 use nalgebra::DVector;
 
 const TOL: f64 = 1e-12;
-
-/// One node, n = 3 dofs, `A = diag(1, 1, 4)`, `N = [1 0 0]`, `T = [−1 1 0]`.
-/// Then `A⁻¹ = diag(1, 1, 1/4)` and, with `B = [[1, 0, 0], [−1, 1, 0]]`,
-///
-/// ```text
-/// W = B A⁻¹ Bᵀ = [[1, −1], [−1, 2]],    q = B A⁻¹ f = (f₁, f₂ − f₁)
-/// ```
-///
-/// (the third dof is decoupled from the contact node and only makes n > 2p).
-fn one_node(friction: f64, f0: [f64; 3], f1: [f64; 3]) -> Data {
-    Data::from_rows(
-        3,
-        1,
-        &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 4.0],
-        &[1.0, 0.0, 0.0],
-        &[-1.0, 1.0, 0.0],
-        vec![friction],
-        &f0,
-        &f1,
-    )
-}
 
 fn lam(v: &[f64]) -> DVector<f64> {
     DVector::from_column_slice(v)
@@ -331,30 +320,7 @@ fn vertical_piece_continuum() {
 /// Solutions: `λ = (−α, −α, −α/2, −α/2)` on (0, 2), `(−α, −α, −1, −1)` beyond.
 #[test]
 fn degenerate_symmetric_transition() {
-    #[rustfmt::skip]
-    let nm = [
-        1.0, 0.0, 0.0, 0.0, 1.0,
-        0.0, 0.0, 1.0, 0.0, -1.0,
-    ];
-    #[rustfmt::skip]
-    let tm = [
-        0.0, 1.0, 0.0, 0.0, 1.0,
-        0.0, 0.0, 0.0, -1.0, -1.0,
-    ];
-    let mut a = [0.0; 25];
-    for i in 0..5 {
-        a[i * 5 + i] = 1.0;
-    }
-    let data = Data::from_rows(
-        5,
-        2,
-        &a,
-        &nm,
-        &tm,
-        vec![0.5, 0.5],
-        &[0.0, 1.0, 0.0, -1.0, 0.0],
-        &[1.0, 0.0, 1.0, 0.0, 0.0],
-    );
+    let data = mirror_pair();
     let problem = Arc::new(data.problem());
     let mut path = trace(problem, data.affine_load(), -1.0, 3.0);
     assert_eq!(path.end_reason(), Some(&EndReason::Window));

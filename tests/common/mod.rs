@@ -695,3 +695,68 @@ pub fn samples(case: &Case, br: &Brute, count: usize, margin: f64) -> Vec<f64> {
     }
     out
 }
+
+// ---------------------------------------------------------------------------------------
+// The hand-derived problems of core_hand.rs (derivations there).
+// ---------------------------------------------------------------------------------------
+
+/// One node, n = 3 dofs, `A = diag(1, 1, 4)`, `N = [1 0 0]`, `T = [−1 1 0]`.
+/// Then `A⁻¹ = diag(1, 1, 1/4)` and, with `B = [[1, 0, 0], [−1, 1, 0]]`,
+///
+/// ```text
+/// W = B A⁻¹ Bᵀ = [[1, −1], [−1, 2]],    q = B A⁻¹ f = (f₁, f₂ − f₁)
+/// ```
+///
+/// (the third dof is decoupled from the contact node and only makes n > 2p).
+pub fn one_node(friction: f64, f0: [f64; 3], f1: [f64; 3]) -> Data {
+    Data::from_rows(
+        3,
+        1,
+        &[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 4.0],
+        &[1.0, 0.0, 0.0],
+        &[-1.0, 1.0, 0.0],
+        vec![friction],
+        &f0,
+        &f1,
+    )
+}
+
+/// Two mirror-symmetric nodes (see `core_hand.rs::degenerate_symmetric_transition`):
+/// n = 5 dofs `(a₁, b₁, a₂, b₂, c)`, `A = I`, `N₁ = a₁ + c`, `T₁ = b₁ + c`, `N₂ = a₂ − c`,
+/// `T₂ = −b₂ − c`, F = 0.5, load `f = (α, 1, α, −1, 0)`.
+pub fn mirror_pair() -> Data {
+    #[rustfmt::skip]
+    let nm = [
+        1.0, 0.0, 0.0, 0.0, 1.0,
+        0.0, 0.0, 1.0, 0.0, -1.0,
+    ];
+    #[rustfmt::skip]
+    let tm = [
+        0.0, 1.0, 0.0, 0.0, 1.0,
+        0.0, 0.0, 0.0, -1.0, -1.0,
+    ];
+    let mut a = [0.0; 25];
+    for i in 0..5 {
+        a[i * 5 + i] = 1.0;
+    }
+    Data::from_rows(
+        5,
+        2,
+        &a,
+        &nm,
+        &tm,
+        vec![0.5, 0.5],
+        &[0.0, 1.0, 0.0, -1.0, 0.0],
+        &[1.0, 0.0, 1.0, 0.0, 0.0],
+    )
+}
+
+/// The fold problem of `core_hand.rs::two_folds_three_solutions` (window [−3, 3]).
+pub fn fold_problem() -> Data {
+    one_node(2.0, [0.0, 1.0, 0.7], [1.0, -1.5, -0.3])
+}
+
+/// The vertical-piece problem of `core_hand.rs::vertical_piece_continuum` (window [−1, 1]).
+pub fn vertical_problem() -> Data {
+    one_node(1.0, [-0.25, 0.75, 0.0], [1.0, 1.0, 0.0])
+}
