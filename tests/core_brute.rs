@@ -33,7 +33,7 @@ fn random_problems_against_enumeration() {
     let mut folds = 0;
     let mut events = 0;
     let mut multi = 0;
-    let seeds = 0..60u64;
+    let seeds = 0..400u64;
     let nseeds = seeds.end;
     for seed in seeds {
         let case = random_case(seed);

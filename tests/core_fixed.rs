@@ -80,9 +80,10 @@ fn check_case(case: &Case, nsamples: usize) -> usize {
         // unique solution: found from random guesses as well
         if all.len() == 1 {
             unique += 1;
-            assert_eq!(
-                sols.len(),
-                1,
+            // (the path may not reach α: after a fold it can leave through the start side;
+            // core_brute.rs checks coverage against its walk)
+            assert!(
+                sols.len() <= 1,
                 "{ctx}: α = {alpha}: unique solution but the path gives {sols:#?}"
             );
             let scale = 1.0 + all[0].1.amax();

@@ -235,9 +235,9 @@ pub struct Brute {
 }
 
 impl Brute {
-    pub fn new(data: &Data) -> Brute {
-        let p = data.p;
-        let n = data.n;
+    /// `(B, W)` of the data.
+    pub fn condensed(data: &Data) -> (DMatrix<f64>, DMatrix<f64>) {
+        let (p, n) = (data.p, data.n);
         let mut b = DMatrix::zeros(2 * p, n);
         b.rows_mut(0, p).copy_from(&data.nm);
         b.rows_mut(p, p).copy_from(&data.tm);
@@ -246,6 +246,13 @@ impl Brute {
         let mut w = &b * &ainv_bt;
         let wt = w.transpose();
         w = (w + wt) * 0.5;
+        (b, w)
+    }
+
+    pub fn new(data: &Data) -> Brute {
+        let p = data.p;
+        let (b, w) = Brute::condensed(data);
+        let chol = data.a.clone().cholesky().expect("A SPD");
         let q0 = &b * chol.solve(&data.f0);
         let q1 = &b * chol.solve(&data.f1);
         let mut br = Brute {
@@ -671,7 +678,17 @@ pub fn random_case(seed: u64) -> Case {
     } else {
         (0.05, 3.0)
     };
-    let data = Data::random(&mut rng, p, n, fmin, fmax, seed % 3 == 0);
+    // Resample until W = B A⁻¹ Bᵀ is well conditioned (κ(W) ≤ 1e3): random dense N, T
+    // can make B nearly rank-deficient, and then transition points are only determined
+    // to κ·ε by the data themselves, whatever the algorithm.
+    let data = loop {
+        let d = Data::random(&mut rng, p, n, fmin, fmax, seed % 3 == 0);
+        let br = Brute::condensed(&d);
+        let ev = br.1.symmetric_eigenvalues();
+        if ev.max() <= 1e3 * ev.min() {
+            break d;
+        }
+    };
     let lo = rng.range(-4.0, -1.0);
     let hi = rng.range(1.0, 4.0);
     let (a0, a1) = if seed % 4 == 3 { (hi, lo) } else { (lo, hi) };
