@@ -232,6 +232,30 @@ pub struct Brute {
     pub pieces: Vec<BrutePiece>,
     /// Number of class assignments with a (numerically) singular matrix.
     pub singular: usize,
+    /// Refine piece solves and evaluate guards with compensated (twice-the-precision)
+    /// dot products.
+    pub precise: bool,
+}
+
+/// Error-free transformation `a + b = s + e`.
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// `Σ a_k b_k` as if computed in twice the working precision, then rounded (the Dot2
+/// algorithm of Ogita, Rump and Oishi).
+pub fn dot2(terms: impl Iterator<Item = (f64, f64)>) -> f64 {
+    let (mut hi, mut lo) = (0.0f64, 0.0f64);
+    for (a, b) in terms {
+        let p = a * b;
+        let pe = a.mul_add(b, -p);
+        let (s, se) = two_sum(hi, p);
+        hi = s;
+        lo += se + pe;
+    }
+    hi + lo
 }
 
 impl Brute {
@@ -249,13 +273,22 @@ impl Brute {
         (b, w)
     }
 
+    /// The condensed problem and every piece (4^p class assignments).
     pub fn new(data: &Data) -> Brute {
+        let mut br = Brute::condensed_only(data);
+        br.enumerate();
+        br
+    }
+
+    /// The condensed problem without the enumeration (for large p): use
+    /// [`Brute::piece_interval`] on given class vectors.
+    pub fn condensed_only(data: &Data) -> Brute {
         let p = data.p;
         let (b, w) = Brute::condensed(data);
         let chol = data.a.clone().cholesky().expect("A SPD");
         let q0 = &b * chol.solve(&data.f0);
         let q1 = &b * chol.solve(&data.f1);
-        let mut br = Brute {
+        Brute {
             data: data.clone(),
             p,
             b,
@@ -264,9 +297,62 @@ impl Brute {
             q1,
             pieces: Vec::new(),
             singular: 0,
+            precise: false,
+        }
+    }
+
+    /// Like [`Brute::condensed_only`], but as accurate as the data allow: every solve with
+    /// A is refined with residuals from compensated dot products (mixed-precision iterative
+    /// refinement), W and q are formed with compensated dot products, and so are the
+    /// piece solves and guards afterwards. The reference for transition points of
+    /// realistic (ill-conditioned A) problems.
+    pub fn condensed_precise(data: &Data) -> Brute {
+        let (p, n) = (data.p, data.n);
+        let mut b = DMatrix::zeros(2 * p, n);
+        b.rows_mut(0, p).copy_from(&data.nm);
+        b.rows_mut(p, p).copy_from(&data.tm);
+        let rows: Vec<Vec<(usize, f64)>> = (0..n)
+            .map(|i| {
+                (0..n)
+                    .filter(|&j| data.a[(i, j)] != 0.0)
+                    .map(|j| (j, data.a[(i, j)]))
+                    .collect()
+            })
+            .collect();
+        let chol = data.a.clone().cholesky().expect("A SPD");
+        let solve = |rhs: &DVector<f64>| -> DVector<f64> {
+            let mut x = chol.solve(rhs);
+            for _ in 0..4 {
+                let r = DVector::from_fn(n, |i, _| {
+                    dot2(
+                        std::iter::once((1.0, rhs[i]))
+                            .chain(rows[i].iter().map(|&(j, v)| (-v, x[j]))),
+                    )
+                });
+                x += chol.solve(&r);
+            }
+            x
         };
-        br.enumerate();
-        br
+        let bdot = |k: usize, x: &DVector<f64>| dot2((0..n).map(|j| (b[(k, j)], x[j])));
+        let xs: Vec<DVector<f64>> = (0..2 * p).map(|k| solve(&b.row(k).transpose())).collect();
+        let mut w = DMatrix::from_fn(2 * p, 2 * p, |k, l| bdot(k, &xs[l]));
+        let wt = w.transpose();
+        w = (w + wt) * 0.5;
+        let x0 = solve(&data.f0);
+        let x1 = solve(&data.f1);
+        let q0 = DVector::from_fn(2 * p, |k, _| bdot(k, &x0));
+        let q1 = DVector::from_fn(2 * p, |k, _| bdot(k, &x1));
+        Brute {
+            data: data.clone(),
+            p,
+            b,
+            w,
+            q0,
+            q1,
+            pieces: Vec::new(),
+            singular: 0,
+            precise: true,
+        }
     }
 
     /// The displacement `u = A⁻¹ (f + Bᵀ λ)`.
@@ -315,12 +401,44 @@ impl Brute {
         if smin <= 1e-11 * smax {
             return None;
         }
-        let lu = m.lu();
-        Some((lu.solve(&r0)?, lu.solve(&r1)?))
+        let lu = m.clone().lu();
+        let mut l0 = lu.solve(&r0)?;
+        let mut l1 = lu.solve(&r1)?;
+        if self.precise {
+            for _ in 0..4 {
+                for (l, r) in [(&mut l0, &r0), (&mut l1, &r1)] {
+                    let res = DVector::from_fn(m2, |i, _| {
+                        dot2(
+                            std::iter::once((1.0, r[i])).chain((0..m2).map(|j| (-m[(i, j)], l[j]))),
+                        )
+                    });
+                    *l += lu.solve(&res)?;
+                }
+            }
+        }
+        Some((l0, l1))
     }
 
     /// `d(λ, φ) = q(φ) + W λ − (g, 0)` for `λ = l0 + φ l1`, as `(d0, d1)`.
     fn gaps(&self, l0: &DVector<f64>, l1: &DVector<f64>) -> (DVector<f64>, DVector<f64>) {
+        if self.precise {
+            let m2 = 2 * self.p;
+            let d = |q: &DVector<f64>, l: &DVector<f64>, gap: bool| {
+                DVector::from_fn(m2, |i, _| {
+                    let g = if gap && i < self.p {
+                        self.data.gap[i]
+                    } else {
+                        0.0
+                    };
+                    dot2(
+                        [(1.0, q[i]), (-1.0, g)]
+                            .into_iter()
+                            .chain((0..m2).map(|j| (self.w[(i, j)], l[j]))),
+                    )
+                })
+            };
+            return (d(&self.q0, l0, true), d(&self.q1, l1, false));
+        }
         let mut d0 = &self.q0 + &self.w * l0;
         for i in 0..self.p {
             d0[i] -= self.data.gap[i];
@@ -378,35 +496,39 @@ impl Brute {
         g
     }
 
+    /// The piece of `classes` with its α-interval (possibly empty: `lo ≥ hi`); `None` if
+    /// its matrix is singular.
+    pub fn piece_interval(&self, classes: &[Class]) -> Option<BrutePiece> {
+        let (l0, l1) = self.piece(classes)?;
+        let mut lo = f64::NEG_INFINITY;
+        let mut hi = f64::INFINITY;
+        for gd in self.guards(classes, &l0, &l1) {
+            if gd.g1 > 0.0 {
+                lo = lo.max(-gd.g0 / gd.g1);
+            } else if gd.g1 < 0.0 {
+                hi = hi.min(-gd.g0 / gd.g1);
+            } else if gd.g0 <= 0.0 {
+                hi = f64::NEG_INFINITY;
+            }
+        }
+        Some(BrutePiece {
+            classes: classes.to_vec(),
+            l0,
+            l1,
+            lo,
+            hi,
+        })
+    }
+
     fn enumerate(&mut self) {
         let p = self.p;
         let total = 4usize.pow(p as u32);
         for code in 0..total {
             let classes: Vec<Class> = (0..p).map(|i| Class::ALL[(code >> (2 * i)) & 3]).collect();
-            let Some((l0, l1)) = self.piece(&classes) else {
-                self.singular += 1;
-                continue;
-            };
-            let mut lo = f64::NEG_INFINITY;
-            let mut hi = f64::INFINITY;
-            let mut empty = false;
-            for gd in self.guards(&classes, &l0, &l1) {
-                if gd.g1 > 0.0 {
-                    lo = lo.max(-gd.g0 / gd.g1);
-                } else if gd.g1 < 0.0 {
-                    hi = hi.min(-gd.g0 / gd.g1);
-                } else if gd.g0 <= 0.0 {
-                    empty = true;
-                }
-            }
-            if !empty && lo < hi {
-                self.pieces.push(BrutePiece {
-                    classes,
-                    l0,
-                    l1,
-                    lo,
-                    hi,
-                });
+            match self.piece_interval(&classes) {
+                None => self.singular += 1,
+                Some(pc) if pc.lo < pc.hi => self.pieces.push(pc),
+                Some(_) => {}
             }
         }
     }
@@ -607,6 +729,37 @@ pub fn check_state(data: &Data, f: &DVector<f64>, s: &State, tol: f64) -> Result
         }
     }
     Ok(())
+}
+
+/// Checks that the equations of class `class` hold at `node` for state `s` (used at a
+/// transition point, which must satisfy the equations of the classes on both sides).
+pub fn class_equations_hold(
+    data: &Data,
+    s: &State,
+    node: usize,
+    class: Class,
+    tol: f64,
+) -> Result<(), String> {
+    let u = DVector::from_column_slice(&s.u);
+    let (l, t) = (s.lambda_n[node], s.lambda_t[node]);
+    let dn = (data.nm.row(node) * &u)[0] - data.gap[node];
+    let dt = (data.tm.row(node) * &u)[0];
+    let f = data.friction[node];
+    let et = tol * 1f64.max(l.abs()).max(t.abs());
+    let eu = tol * 1f64.max(u.amax());
+    let ok = match class {
+        Class::Open => l.abs() <= et && t.abs() <= et,
+        Class::Stick => dn.abs() <= eu && dt.abs() <= eu,
+        Class::SlipPlus => dn.abs() <= eu && (t - f * l).abs() <= et,
+        Class::SlipMinus => dn.abs() <= eu && (t + f * l).abs() <= et,
+    };
+    if ok {
+        Ok(())
+    } else {
+        Err(format!(
+            "node {node}: {class} equations fail: λ = ({l}, {t}), d = ({dn}, {dt})"
+        ))
+    }
 }
 
 // ---------------------------------------------------------------------------------------
