@@ -56,8 +56,8 @@ fn loads(data: &Data) -> Vec<(&'static str, Load)> {
     let mk_f = |f0: Vec<f64>, f1: Vec<f64>| -> VectorFn {
         Box::new(move |b: f64, out: &mut [f64]| {
             let s = phi(b);
-            for i in 0..out.len() {
-                out[i] = f0[i] + s * f1[i];
+            for ((o, a), b) in out.iter_mut().zip(&f0).zip(&f1) {
+                *o = a + s * b;
             }
             Ok(())
         })
@@ -65,8 +65,8 @@ fn loads(data: &Data) -> Vec<(&'static str, Load)> {
     let f1d = f1.clone();
     let df: VectorFn = Box::new(move |b: f64, out: &mut [f64]| {
         let s = dphi(b);
-        for i in 0..out.len() {
-            out[i] = s * f1d[i];
+        for (o, b) in out.iter_mut().zip(&f1d) {
+            *o = s * b;
         }
         Ok(())
     });

@@ -440,8 +440,8 @@ impl Brute {
             return (d(&self.q0, l0, true), d(&self.q1, l1, false));
         }
         let mut d0 = &self.q0 + &self.w * l0;
-        for i in 0..self.p {
-            d0[i] -= self.data.gap[i];
+        for (d, g) in d0.iter_mut().zip(&self.data.gap) {
+            *d -= g;
         }
         let d1 = &self.q1 + &self.w * l1;
         (d0, d1)
