@@ -930,3 +930,102 @@ pub fn fold_problem() -> Data {
 pub fn vertical_problem() -> Data {
     one_node(1.0, [-0.25, 0.75, 0.0], [1.0, 1.0, 0.0])
 }
+
+impl Brute {
+    /// Every piece (of length > `min_len` in φ) whose closure contains the point
+    /// `(φ, λ)`: at a transition point, the pieces that meet there.
+    pub fn incident(&self, phi: f64, lam: &DVector<f64>, min_len: f64) -> Vec<Vec<Class>> {
+        let tol = 1e-9 * 1f64.max(phi.abs());
+        self.pieces
+            .iter()
+            .filter(|pc| pc.hi - pc.lo > min_len)
+            .filter(|pc| (pc.lo - phi).abs() <= tol || (pc.hi - phi).abs() <= tol)
+            .filter(|pc| vclose(&pc.lambda(phi), lam, 1e-7))
+            .map(|pc| pc.classes.clone())
+            .collect()
+    }
+}
+
+/// A random mirror-symmetric problem: a signed-permutation involution `P` (side dofs of
+/// node 1 ↔ side dofs of node 2, centre dofs fixed or negated), `A = (A₀ + P A₀ P)/2`,
+/// node 2 the mirror image of node 1 (`N₂ = N₁ P`, `T₂ = T₁ P`, same F and gap), an
+/// optional centre node 3 on the axis (`N₃ P = N₃`, `T₃ P = −T₃`), a symmetric load
+/// (`P f = f`). The symmetric solution has nodes 1 and 2 in the same class, switching at
+/// the same α, and the centre node with `λt = dt = 0`.
+pub fn symmetric_case(seed: u64, centre: bool) -> Case {
+    let mut rng = Rng::new(seed.wrapping_add(0x5EED));
+    let k = rng.int(2, 3);
+    let cs = rng.int(1, 2);
+    let ca = rng.int(1, 2);
+    let n = 2 * k + cs + ca;
+    let mut pm = DMatrix::zeros(n, n);
+    for j in 0..k {
+        let s = if rng.uniform() < 0.5 { 1.0 } else { -1.0 };
+        pm[(k + j, j)] = s;
+        pm[(j, k + j)] = s;
+    }
+    for j in 0..cs {
+        pm[(2 * k + j, 2 * k + j)] = 1.0;
+    }
+    for j in 0..ca {
+        pm[(2 * k + cs + j, 2 * k + cs + j)] = -1.0;
+    }
+    let p = if centre { 3 } else { 2 };
+    let fr = rng.range(0.1, 3.0);
+    let fc = rng.range(0.1, 3.0);
+    let gap = if seed % 3 == 0 {
+        rng.range(-0.1, 0.1)
+    } else {
+        0.0
+    };
+    let data = loop {
+        let m = DMatrix::from_fn(n, n, |_, _| rng.range(-1.0, 1.0));
+        let a0 = &m * m.transpose() + DMatrix::identity(n, n) * (0.5 * n as f64);
+        let mut a = (&a0 + &pm * &a0 * &pm) * 0.5;
+        let at = a.transpose();
+        a = (a + at) * 0.5;
+        let n1 = DMatrix::from_fn(1, n, |_, _| rng.range(-1.0, 1.0));
+        let t1 = DMatrix::from_fn(1, n, |_, _| rng.range(-1.0, 1.0));
+        let mut nm = DMatrix::zeros(p, n);
+        let mut tm = DMatrix::zeros(p, n);
+        nm.row_mut(0).copy_from(&n1);
+        tm.row_mut(0).copy_from(&t1);
+        nm.row_mut(1).copy_from(&(&n1 * &pm));
+        tm.row_mut(1).copy_from(&(&t1 * &pm));
+        if centre {
+            let r = DMatrix::from_fn(1, n, |_, _| rng.range(-1.0, 1.0));
+            let s = DMatrix::from_fn(1, n, |_, _| rng.range(-1.0, 1.0));
+            nm.row_mut(2).copy_from(&((&r + &r * &pm) * 0.5));
+            tm.row_mut(2).copy_from(&((&s - &s * &pm) * 0.5));
+        }
+        let sym = |v: DVector<f64>| (&v + &pm * &v) * 0.5;
+        let f0 = sym(DVector::from_fn(n, |_, _| rng.range(-1.0, 1.0)));
+        let f1 = sym(DVector::from_fn(n, |_, _| rng.range(-1.0, 1.0)));
+        let mut friction = vec![fr, fr];
+        let mut gaps = vec![gap, gap];
+        if centre {
+            friction.push(fc);
+            gaps.push(0.0);
+        }
+        let d = Data {
+            n,
+            p,
+            a,
+            nm,
+            tm,
+            friction,
+            gap: gaps,
+            f0,
+            f1,
+        };
+        let (_, w) = Brute::condensed(&d);
+        let ev = w.symmetric_eigenvalues();
+        if ev.max() <= 1e3 * ev.min() {
+            break d;
+        }
+    };
+    let lo = rng.range(-4.0, -1.0);
+    let hi = rng.range(1.0, 4.0);
+    let (a0, a1) = if seed % 2 == 1 { (hi, lo) } else { (lo, hi) };
+    Case { seed, data, a0, a1 }
+}
