@@ -54,8 +54,14 @@ fn loads(f0: &[f64], f1: &[f64], amp: f64) -> Vec<(&'static str, Load)> {
     .unwrap();
     vec![
         ("basis", basis),
-        ("general with f'", Load::general(f0.len(), mk(f0.to_vec(), f1.to_vec()), Some(df))),
-        ("general without f'", Load::general(f0.len(), mk(f0.to_vec(), f1.to_vec()), None)),
+        (
+            "general with f'",
+            Load::general(f0.len(), mk(f0.to_vec(), f1.to_vec()), Some(df)),
+        ),
+        (
+            "general without f'",
+            Load::general(f0.len(), mk(f0.to_vec(), f1.to_vec()), None),
+        ),
     ]
 }
 
@@ -82,20 +88,34 @@ fn sine_load(margin: f64) {
             continue;
         }
         let start = &br.solutions_at(-3.0)[0].1;
-        let Some(walk) = br.walk(-3.0, 3.0, start) else { continue };
+        let Some(walk) = br.walk(-3.0, 3.0, start) else {
+            continue;
+        };
         if walk.events.iter().any(|e| e.fold) || walk.events.is_empty() {
             continue;
         }
-        let top = walk.events.iter().map(|e| e.phi).fold(f64::NEG_INFINITY, f64::max);
+        let top = walk
+            .events
+            .iter()
+            .map(|e| e.phi)
+            .fold(f64::NEG_INFINITY, f64::max);
         if !(0.3..2.9).contains(&top) {
             continue;
         }
         let amp = top + margin;
         // expected events in β ∈ [0, 2π]
         let mut expected: Vec<(f64, usize, Class, Class, f64)> = Vec::new();
-        for e in walk.events.iter().filter(|e| e.phi.abs() < amp && e.phi != 0.0) {
+        for e in walk
+            .events
+            .iter()
+            .filter(|e| e.phi.abs() < amp && e.phi != 0.0)
+        {
             let s = (e.phi / amp).asin(); // in (−π/2, π/2)
-            let (up, down) = if e.phi > 0.0 { (s, PI - s) } else { (2.0 * PI + s, PI - s) };
+            let (up, down) = if e.phi > 0.0 {
+                (s, PI - s)
+            } else {
+                (2.0 * PI + s, PI - s)
+            };
             expected.push((up, e.node, e.from, e.to, e.phi));
             expected.push((down, e.node, e.to, e.from, e.phi));
         }
@@ -103,24 +123,47 @@ fn sine_load(margin: f64) {
         let problem = Arc::new(data.problem());
         for (name, load) in loads(data.f0.as_slice(), data.f1.as_slice(), amp) {
             let ctx = format!("seed {seed}, {name}, A = {amp}");
-            let mut path = Path::new(problem.clone(), load, PathOptions::window(0.0, 2.0 * PI)).unwrap();
+            let mut path =
+                Path::new(problem.clone(), load, PathOptions::window(0.0, 2.0 * PI)).unwrap();
             path.start(0.0, None).unwrap();
             assert_eq!(path.run().unwrap(), EndReason::Window, "{ctx}");
             let ev = path.events();
             let show = || {
                 format!(
                     "expected {:#?}\ngot {:#?}",
-                    expected.iter().map(|x| format!("β {:.15} node {} {} -> {}", x.0, x.1, x.2, x.3)).collect::<Vec<_>>(),
-                    ev.iter().map(|e| format!("β {:.15} node {} {} -> {}", e.alpha, e.node, e.from, e.to)).collect::<Vec<_>>()
+                    expected
+                        .iter()
+                        .map(|x| format!("β {:.15} node {} {} -> {}", x.0, x.1, x.2, x.3))
+                        .collect::<Vec<_>>(),
+                    ev.iter()
+                        .map(|e| format!(
+                            "β {:.15} node {} {} -> {}",
+                            e.alpha, e.node, e.from, e.to
+                        ))
+                        .collect::<Vec<_>>()
                 )
             };
             assert_eq!(ev.len(), expected.len(), "{ctx}: {}", show());
             for (e, x) in ev.iter().zip(&expected) {
-                assert_eq!((e.node, e.from, e.to, e.fold), (x.1, x.2, x.3, false), "{ctx}: {}", show());
+                assert_eq!(
+                    (e.node, e.from, e.to, e.fold),
+                    (x.1, x.2, x.3, false),
+                    "{ctx}: {}",
+                    show()
+                );
                 let phi = amp * e.alpha.sin();
-                assert!((phi - x.4).abs() <= 1e-12 * x.4.abs().max(1.0), "{ctx}: φ(β) = {phi:.17e} at the event, affine event {:.17e}", x.4);
+                assert!(
+                    (phi - x.4).abs() <= 1e-12 * x.4.abs().max(1.0),
+                    "{ctx}: φ(β) = {phi:.17e} at the event, affine event {:.17e}",
+                    x.4
+                );
                 let cond = f64::EPSILON / (amp * x.0.cos()).abs();
-                assert!((e.alpha - x.0).abs() <= 1e-12 * x.0.abs().max(1.0) + 4.0 * cond, "{ctx}: β = {:.17e}, expected {:.17e}", e.alpha, x.0);
+                assert!(
+                    (e.alpha - x.0).abs() <= 1e-12 * x.0.abs().max(1.0) + 4.0 * cond,
+                    "{ctx}: β = {:.17e}, expected {:.17e}",
+                    e.alpha,
+                    x.0
+                );
                 assert!(e.state.residual <= 1e-12, "{ctx}");
             }
             // the traced solution follows the affine one: λ(β) = λ_aff(φ(β))
@@ -130,7 +173,10 @@ fn sine_load(margin: f64) {
                 assert_eq!(sols.len(), 1, "{ctx}: β = {b}");
                 let want = &br.solutions_at(amp * b.sin())[0].1;
                 let got = lambda_of(&sols[0].state);
-                assert!((want - &got).amax() <= 1e-9 * (1.0 + want.amax()), "{ctx}: β = {b}");
+                assert!(
+                    (want - &got).amax() <= 1e-9 * (1.0 + want.amax()),
+                    "{ctx}: β = {b}"
+                );
             }
         }
         done += 1;

@@ -1029,3 +1029,126 @@ pub fn symmetric_case(seed: u64, centre: bool) -> Case {
     let (a0, a1) = if seed % 2 == 1 { (hi, lo) } else { (lo, hi) };
     Case { seed, data, a0, a1 }
 }
+
+/// A small finite-element case (independent of `src/gen.rs`): plane-strain Q1 elements
+/// (E = 1, ν = 0.3, 2×2 Gauss) on an `nx × ny` grid of the rectangle (0, L) × (0, H), the
+/// left edge clamped (its dofs eliminated), the bottom nodes right of the corner in
+/// contact with a rigid foundation (`N u = −u_y`, `T u = u_x`, so p = nx), a top
+/// pressure plus random perturbations as f0, a random top shear/lift and right-edge
+/// traction as f1, friction `friction` at every node.
+pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
+    let mut rng = Rng::new(seed.wrapping_add(0xFE));
+    let (lx, ly) = (rng.range(1.0, 3.0), rng.range(0.5, 2.0));
+    let (hx, hy) = (lx / nx as f64, ly / ny as f64);
+    let (e, nu) = (1.0, 0.3);
+    let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let d = [
+        [c * (1.0 - nu), c * nu, 0.0],
+        [c * nu, c * (1.0 - nu), 0.0],
+        [0.0, 0.0, c * (1.0 - 2.0 * nu) / 2.0],
+    ];
+    // element stiffness (8×8), local nodes (0,0), (1,0), (1,1), (0,1)
+    let xi = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+    let g = 1.0 / 3f64.sqrt();
+    let mut ke = [[0.0; 8]; 8];
+    for &(gx, gy) in &[(-g, -g), (g, -g), (g, g), (-g, g)] {
+        let mut b = [[0.0; 8]; 3];
+        for (a, &(xa, ya)) in xi.iter().enumerate() {
+            let dx = 0.25 * xa * (1.0 + ya * gy) * 2.0 / hx;
+            let dy = 0.25 * ya * (1.0 + xa * gx) * 2.0 / hy;
+            b[0][2 * a] = dx;
+            b[1][2 * a + 1] = dy;
+            b[2][2 * a] = dy;
+            b[2][2 * a + 1] = dx;
+        }
+        let det = hx * hy / 4.0;
+        for i in 0..8 {
+            for j in 0..8 {
+                let mut s = 0.0;
+                for k in 0..3 {
+                    for l in 0..3 {
+                        s += b[k][i] * d[k][l] * b[l][j];
+                    }
+                }
+                ke[i][j] += s * det;
+            }
+        }
+    }
+    // free dofs: nodes with i ≥ 1
+    let node = |i: usize, j: usize| j * (nx + 1) + i;
+    let dof = |i: usize, j: usize, k: usize| -> Option<usize> {
+        if i == 0 {
+            None
+        } else {
+            Some(2 * (j * nx + (i - 1)) + k)
+        }
+    };
+    let _ = node;
+    let n = 2 * nx * (ny + 1);
+    let mut a = DMatrix::zeros(n, n);
+    for ei in 0..nx {
+        for ej in 0..ny {
+            let nodes = [(ei, ej), (ei + 1, ej), (ei + 1, ej + 1), (ei, ej + 1)];
+            for (la, &(ia, ja)) in nodes.iter().enumerate() {
+                for ka in 0..2 {
+                    let Some(ra) = dof(ia, ja, ka) else { continue };
+                    for (lb, &(ib, jb)) in nodes.iter().enumerate() {
+                        for kb in 0..2 {
+                            let Some(cb) = dof(ib, jb, kb) else { continue };
+                            a[(ra, cb)] += ke[2 * la + ka][2 * lb + kb];
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let at = a.transpose();
+    a = (a + at) * 0.5;
+    let p = nx;
+    let mut nm = DMatrix::zeros(p, n);
+    let mut tm = DMatrix::zeros(p, n);
+    for i in 1..=nx {
+        nm[(i - 1, dof(i, 0, 1).unwrap())] = -1.0;
+        tm[(i - 1, dof(i, 0, 0).unwrap())] = 1.0;
+    }
+    let mut f0 = DVector::from_fn(n, |_, _| rng.range(-0.02, 0.02));
+    let mut f1 = DVector::from_fn(n, |_, _| rng.range(-0.02, 0.02));
+    let press = rng.range(0.05, 0.2);
+    let (sx, sy) = (rng.range(-0.2, 0.2), rng.range(-0.1, 0.1));
+    let (rx, ry) = (rng.range(-0.1, 0.1), rng.range(-0.1, 0.1));
+    for i in 1..=nx {
+        f0[dof(i, ny, 1).unwrap()] -= press / nx as f64;
+        f1[dof(i, ny, 0).unwrap()] += sx / nx as f64;
+        f1[dof(i, ny, 1).unwrap()] += sy / nx as f64;
+    }
+    for j in 0..=ny {
+        f1[dof(nx, j, 0).unwrap()] += rx / (ny + 1) as f64;
+        f1[dof(nx, j, 1).unwrap()] += ry / (ny + 1) as f64;
+    }
+    let gap = (0..p)
+        .map(|_| {
+            if seed % 3 == 0 {
+                rng.range(0.0, 0.05)
+            } else {
+                0.0
+            }
+        })
+        .collect();
+    let data = Data {
+        n,
+        p,
+        a,
+        nm,
+        tm,
+        friction: vec![friction; p],
+        gap,
+        f0,
+        f1,
+    };
+    let (a0, a1) = if seed % 2 == 0 {
+        (-2.0, 4.0)
+    } else {
+        (4.0, -2.0)
+    };
+    Case { seed, data, a0, a1 }
+}
