@@ -54,7 +54,7 @@ struct TraceArgs {
     #[arg(long, allow_negative_numbers = true)]
     alpha_end: Option<f64>,
     /// Augmentation parameter r > 0 (default: 2p / trace W). Does not change the path.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     r: Option<f64>,
     /// Stop after this many transition points.
     #[arg(long)]
