@@ -59,6 +59,7 @@ fn main() {
 
     let mut setup = Vec::with_capacity(reps);
     let mut trace = Vec::with_capacity(reps);
+    let mut start = Vec::with_capacity(reps);
     let mut summary = String::new();
     for _ in 0..reps {
         let t = Instant::now();
@@ -76,6 +77,7 @@ fn main() {
         let mut path = Path::new(problem, case.load().expect("load"), opts.clone()).expect("path");
         let t = Instant::now();
         path.start(opts.alpha_start, None).expect("start");
+        start.push(t.elapsed().as_secs_f64());
         let end = path.run().expect("run");
         trace.push(t.elapsed().as_secs_f64());
         std::hint::black_box(path.events().len());
@@ -88,6 +90,7 @@ fn main() {
     }
     let (s_med, s_min) = median_min(&mut setup);
     let (t_med, t_min) = median_min(&mut trace);
+    let (st_med, st_min) = median_min(&mut start);
     println!(
         "case {} (n = {}, p = {}), {reps} repetitions; {summary}",
         dir.display(),
@@ -104,6 +107,11 @@ fn main() {
         "trace   median {:>12.6} ms   min {:>12.6} ms   (start solve + all steps)",
         t_med * 1e3,
         t_min * 1e3
+    );
+    println!(
+        "  of which start solve: median {:>12.6} ms   min {:>12.6} ms",
+        st_med * 1e3,
+        st_min * 1e3
     );
     println!(
         "ratio trace/set-up: median {:.4}, min {:.4}",

@@ -112,10 +112,8 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
 
     print!("{}", report::table(&mut path, Some(timing)));
     if let Some(file) = &args.json {
-        let value = report::path_json(&mut path, timing);
-        let text = serde_json::to_string_pretty(&value)
-            .map_err(|e| runtime(format!("cannot serialise the JSON report: {e}")))?;
-        std::fs::write(file, text + "\n")
+        let text = report::PathReport::from_path(&mut path, timing).to_json_string();
+        std::fs::write(file, text)
             .map_err(|e| runtime(format!("cannot write {}: {e}", file.display())))?;
     }
     match run {

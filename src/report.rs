@@ -8,7 +8,7 @@
 
 use std::fmt::Write as _;
 
-use serde_json::{Map, Value, json};
+use serde_json::Value;
 
 use crate::class::Class;
 use crate::path::{EndReason, Event, Path};
@@ -43,32 +43,42 @@ fn num(x: f64) -> Value {
     serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)
 }
 
-fn class_names(c: &[Class]) -> Value {
-    Value::Array(c.iter().map(|c| Value::from(c.name())).collect())
+/// Serialises an `f64` as a JSON number (shortest round-trip form), or `null` when it is
+/// not finite (JSON has no NaN or infinity).
+fn ser_num<S: serde::Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
+    if x.is_finite() {
+        s.serialize_f64(*x)
+    } else {
+        s.serialize_none()
+    }
 }
 
-fn event_json(e: &Event) -> Value {
-    let mut o = Map::new();
-    o.insert("index".into(), json!(e.index + 1));
-    o.insert("alpha".into(), num(e.alpha));
-    o.insert("node".into(), json!(e.node + 1));
-    o.insert("from".into(), json!(e.from.name()));
-    o.insert("to".into(), json!(e.to.name()));
-    o.insert("fold".into(), json!(e.fold));
-    o.insert("bifurcation".into(), json!(e.bifurcation));
-    o.insert("residual".into(), num(e.state.residual));
-    // Extra keys.
-    o.insert("transition".into(), json!(e.transition + 1));
-    if let Some(&l) = e.state.lambda_n.get(e.node) {
-        o.insert("lambda_n".into(), num(l));
+fn ser_nums<S: serde::Serializer>(v: &[f64], s: S) -> Result<S::Ok, S::Error> {
+    use serde::ser::SerializeSeq;
+    let mut seq = s.serialize_seq(Some(v.len()))?;
+    for x in v {
+        if x.is_finite() {
+            seq.serialize_element(x)?;
+        } else {
+            seq.serialize_element(&Option::<f64>::None)?;
+        }
     }
-    if let Some(&l) = e.state.lambda_t.get(e.node) {
-        o.insert("lambda_t".into(), num(l));
-    }
-    Value::Object(o)
+    seq.end()
 }
 
-/// The JSON object of SPEC §8 for a path (started, and normally run to its end).
+fn ser_classes<S: serde::Serializer>(v: &[Class], s: S) -> Result<S::Ok, S::Error> {
+    s.collect_seq(v.iter().map(|c| c.name()))
+}
+
+fn ser_opt_num<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok, S::Error> {
+    match x {
+        Some(x) if x.is_finite() => s.serialize_f64(*x),
+        _ => s.serialize_none(),
+    }
+}
+
+/// The report of a path (SPEC §8), with its fields in the order of the SPEC. Serialise it
+/// with `serde_json` (the CLI does); [`path_json`] gives it as a [`Value`].
 ///
 /// Required keys: `n`, `p`, `r`, `alpha_start`, `alpha_end` (the window as asked),
 /// `start {alpha, classes, residual}`, `events [{index, alpha, node, from, to, fold,
@@ -79,103 +89,265 @@ fn event_json(e: &Event) -> Value {
 /// event, per piece `direction` (sign of dα/ds, 0 for a vertical piece), `orientation`,
 /// `det_sign`, `end.message` for a failure, `end.branches` for a bifurcation stop, and
 /// `n_events`, `n_transitions`, `residual_max`.
-///
-/// For a path that was never started, `start` and `end.alpha` are `null`; for one still
-/// running, `end.reason` is `null`. The path is taken `&mut` only to evaluate the current
-/// point (one back-solve).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PathReport {
+    /// Number of dofs.
+    pub n: usize,
+    /// Number of contact nodes.
+    pub p: usize,
+    /// Augmentation parameter in use.
+    #[serde(serialize_with = "ser_num")]
+    pub r: f64,
+    /// Window start (where the path starts).
+    #[serde(serialize_with = "ser_num")]
+    pub alpha_start: f64,
+    /// Window end (traced toward first).
+    #[serde(serialize_with = "ser_num")]
+    pub alpha_end: f64,
+    /// Friction: a number when uniform, else one per node.
+    #[serde(rename = "F")]
+    pub friction: Value,
+    /// The start point (`null` if the path was never started).
+    pub start: Option<StartReport>,
+    /// One per event, in path order.
+    pub events: Vec<EventReport>,
+    /// One per traced piece, in path order.
+    pub pieces: Vec<PieceReport>,
+    /// Number of events.
+    pub n_events: usize,
+    /// Number of transition points.
+    pub n_transitions: usize,
+    /// Largest residual of the start point and the events.
+    #[serde(serialize_with = "ser_num")]
+    pub residual_max: f64,
+    /// Where and why the path ended.
+    pub end: EndReport,
+    /// Wall-clock times.
+    pub timing: TimingReport,
+}
+
+/// The start point in a [`PathReport`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct StartReport {
+    /// α of the start.
+    #[serde(serialize_with = "ser_num")]
+    pub alpha: f64,
+    /// Class of every node.
+    #[serde(serialize_with = "ser_classes")]
+    pub classes: Vec<Class>,
+    /// `‖H‖∞` relative to the data scale.
+    #[serde(serialize_with = "ser_num")]
+    pub residual: f64,
+    /// Normal contact forces (≤ 0 compressive).
+    #[serde(serialize_with = "ser_nums")]
+    pub lambda_n: Vec<f64>,
+    /// Tangential contact forces.
+    #[serde(serialize_with = "ser_nums")]
+    pub lambda_t: Vec<f64>,
+}
+
+/// One event in a [`PathReport`] (1-based counts).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EventReport {
+    /// 1-based position in the event list.
+    pub index: usize,
+    /// α of the transition point.
+    #[serde(serialize_with = "ser_num")]
+    pub alpha: f64,
+    /// 1-based contact node.
+    pub node: usize,
+    /// Class before (`"open"`, `"stick"`, `"slip+"`, `"slip-"`).
+    pub from: &'static str,
+    /// Class after.
+    pub to: &'static str,
+    /// α turns back here.
+    pub fold: bool,
+    /// Several pieces continue the path here.
+    pub bifurcation: bool,
+    /// `‖H‖∞` relative to the data scale, at the event.
+    #[serde(serialize_with = "ser_num")]
+    pub residual: f64,
+    /// 1-based transition point (shared by the events of a degenerate transition).
+    pub transition: usize,
+    /// λν of the node at the event.
+    #[serde(serialize_with = "ser_opt_num")]
+    pub lambda_n: Option<f64>,
+    /// λt of the node at the event.
+    #[serde(serialize_with = "ser_opt_num")]
+    pub lambda_t: Option<f64>,
+}
+
+/// One traced piece in a [`PathReport`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct PieceReport {
+    /// α where the path entered the piece.
+    #[serde(serialize_with = "ser_num")]
+    pub alpha_from: f64,
+    /// α where the path left it.
+    #[serde(serialize_with = "ser_num")]
+    pub alpha_to: f64,
+    /// Class of every node on the piece.
+    #[serde(serialize_with = "ser_classes")]
+    pub classes: Vec<Class>,
+    /// Sign of dα/ds (0: vertical piece, a continuum of solutions at one α).
+    pub direction: i8,
+    /// Orientation sign of the path on the piece.
+    pub orientation: i8,
+    /// Sign of det ∂H/∂λ on the piece.
+    pub det_sign: i8,
+}
+
+/// The end of the path in a [`PathReport`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct EndReport {
+    /// α of the last point reached (`null` if never started).
+    #[serde(serialize_with = "ser_opt_num")]
+    pub alpha: Option<f64>,
+    /// [`EndReason::name`] (`null` while the path is still running).
+    pub reason: Option<&'static str>,
+    /// The failure message, for `"failed"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub message: Option<String>,
+    /// The candidate branches, for `"bifurcation"`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub branches: Option<Vec<BranchReport>>,
+}
+
+/// A candidate continuation at a bifurcation stop.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct BranchReport {
+    /// Classes of the candidate piece.
+    #[serde(serialize_with = "ser_classes")]
+    pub classes: Vec<Class>,
+    /// Sign of dα/ds along it.
+    pub direction: i8,
+    /// Whether it keeps the path's orientation.
+    pub orientation_preserving: bool,
+}
+
+/// Timing in a [`PathReport`], seconds.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct TimingReport {
+    /// Set-up time (see [`Timing::setup_s`]).
+    #[serde(serialize_with = "ser_num")]
+    pub setup_s: f64,
+    /// Trace time (see [`Timing::trace_s`]).
+    #[serde(serialize_with = "ser_num")]
+    pub trace_s: f64,
+}
+
+impl PathReport {
+    /// Collects the report of a path (started, and normally run to its end). For a path
+    /// never started, `start` and `end.alpha` are `None`; for one still running,
+    /// `end.reason` is `None`. The path is taken `&mut` only to evaluate the current point
+    /// (one back-solve).
+    pub fn from_path(path: &mut Path, timing: Timing) -> PathReport {
+        let (end_alpha, reason) = end_point(path);
+        let problem = path.problem().clone();
+        let opts = path.options().clone();
+        let fr = problem.friction();
+        let friction = if fr.iter().all(|&x| x == fr[0]) {
+            num(fr[0])
+        } else {
+            Value::Array(fr.iter().map(|&x| num(x)).collect())
+        };
+        let start = path.start_state().map(|s| StartReport {
+            alpha: s.alpha,
+            classes: s.classes.clone(),
+            residual: s.residual,
+            lambda_n: s.lambda_n.clone(),
+            lambda_t: s.lambda_t.clone(),
+        });
+        let events: Vec<EventReport> = path
+            .events()
+            .iter()
+            .map(|e: &Event| EventReport {
+                index: e.index + 1,
+                alpha: e.alpha,
+                node: e.node + 1,
+                from: e.from.name(),
+                to: e.to.name(),
+                fold: e.fold,
+                bifurcation: e.bifurcation,
+                residual: e.state.residual,
+                transition: e.transition + 1,
+                lambda_n: e.state.lambda_n.get(e.node).copied(),
+                lambda_t: e.state.lambda_t.get(e.node).copied(),
+            })
+            .collect();
+        let residual_max = start
+            .iter()
+            .map(|s| s.residual)
+            .chain(events.iter().map(|e| e.residual))
+            .fold(0.0_f64, f64::max);
+        let pieces = path
+            .pieces()
+            .iter()
+            .map(|p| PieceReport {
+                alpha_from: p.alpha_from,
+                alpha_to: p.alpha_to,
+                classes: p.classes.clone(),
+                direction: p.direction,
+                orientation: p.orientation,
+                det_sign: p.det_sign,
+            })
+            .collect();
+        let end = EndReport {
+            alpha: end_alpha,
+            reason: reason.as_ref().map(EndReason::name),
+            message: match &reason {
+                Some(EndReason::Failed(m)) => Some(m.clone()),
+                _ => None,
+            },
+            branches: match &reason {
+                Some(EndReason::Bifurcation) => Some(
+                    path.branches()
+                        .iter()
+                        .map(|b| BranchReport {
+                            classes: b.classes.clone(),
+                            direction: b.direction,
+                            orientation_preserving: b.orientation_preserving,
+                        })
+                        .collect(),
+                ),
+                _ => None,
+            },
+        };
+        PathReport {
+            n: problem.n(),
+            p: problem.p(),
+            r: problem.r(),
+            alpha_start: opts.alpha_start,
+            alpha_end: opts.alpha_end,
+            friction,
+            start,
+            n_events: events.len(),
+            n_transitions: events.last().map_or(0, |e| e.transition),
+            events,
+            pieces,
+            residual_max,
+            end,
+            timing: TimingReport {
+                setup_s: timing.setup_s,
+                trace_s: timing.trace_s,
+            },
+        }
+    }
+
+    /// The report as pretty-printed JSON text (keys in the order of SPEC §8), ending with a
+    /// newline.
+    pub fn to_json_string(&self) -> String {
+        // Serialising plain data with string keys cannot fail.
+        let mut s = serde_json::to_string_pretty(self).unwrap_or_default();
+        s.push('\n');
+        s
+    }
+}
+
+/// The JSON object of SPEC §8 for a path, as a [`Value`] (see [`PathReport`] for the keys;
+/// a `Value` does not keep the key order, [`PathReport::to_json_string`] does).
 pub fn path_json(path: &mut Path, timing: Timing) -> Value {
-    let (end_alpha, reason) = end_point(path);
-    let problem = path.problem().clone();
-    let opts = path.options().clone();
-    let mut o = Map::new();
-    o.insert("n".into(), json!(problem.n()));
-    o.insert("p".into(), json!(problem.p()));
-    o.insert("r".into(), num(problem.r()));
-    o.insert("alpha_start".into(), num(opts.alpha_start));
-    o.insert("alpha_end".into(), num(opts.alpha_end));
-    let fr = problem.friction();
-    let f = if fr.iter().all(|&x| x == fr[0]) {
-        num(fr[0])
-    } else {
-        Value::Array(fr.iter().map(|&x| num(x)).collect())
-    };
-    o.insert("F".into(), f);
-    let mut residual_max: f64 = 0.0;
-    let start = match path.start_state() {
-        Some(s) => {
-            residual_max = residual_max.max(s.residual);
-            json!({
-                "alpha": num(s.alpha),
-                "classes": class_names(&s.classes),
-                "residual": num(s.residual),
-                "lambda_n": s.lambda_n.iter().map(|&x| num(x)).collect::<Vec<_>>(),
-                "lambda_t": s.lambda_t.iter().map(|&x| num(x)).collect::<Vec<_>>(),
-            })
-        }
-        None => Value::Null,
-    };
-    o.insert("start".into(), start);
-    let events = path.events();
-    for e in events {
-        residual_max = residual_max.max(e.state.residual);
-    }
-    o.insert(
-        "events".into(),
-        Value::Array(events.iter().map(event_json).collect()),
-    );
-    o.insert("n_events".into(), json!(events.len()));
-    o.insert(
-        "n_transitions".into(),
-        json!(events.last().map_or(0, |e| e.transition + 1)),
-    );
-    o.insert("residual_max".into(), num(residual_max));
-    let pieces: Vec<Value> = path
-        .pieces()
-        .iter()
-        .map(|p| {
-            json!({
-                "alpha_from": num(p.alpha_from),
-                "alpha_to": num(p.alpha_to),
-                "classes": class_names(&p.classes),
-                "direction": p.direction,
-                "orientation": p.orientation,
-                "det_sign": p.det_sign,
-            })
-        })
-        .collect();
-    o.insert("pieces".into(), Value::Array(pieces));
-    let mut end = Map::new();
-    end.insert("alpha".into(), end_alpha.map_or(Value::Null, num));
-    end.insert(
-        "reason".into(),
-        reason.as_ref().map_or(Value::Null, |r| json!(r.name())),
-    );
-    match &reason {
-        Some(EndReason::Failed(msg)) => {
-            end.insert("message".into(), json!(msg));
-        }
-        Some(EndReason::Bifurcation) => {
-            let br: Vec<Value> = path
-                .branches()
-                .iter()
-                .map(|b| {
-                    json!({
-                        "classes": class_names(&b.classes),
-                        "direction": b.direction,
-                        "orientation_preserving": b.orientation_preserving,
-                    })
-                })
-                .collect();
-            end.insert("branches".into(), Value::Array(br));
-        }
-        _ => {}
-    }
-    o.insert("end".into(), Value::Object(end));
-    o.insert(
-        "timing".into(),
-        json!({"setup_s": num(timing.setup_s), "trace_s": num(timing.trace_s)}),
-    );
-    Value::Object(o)
+    serde_json::to_value(PathReport::from_path(path, timing)).unwrap_or(Value::Null)
 }
 
 /// α with 14 significant digits, e.g. `2.8019791259766e-1`.
