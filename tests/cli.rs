@@ -454,6 +454,73 @@ fn max_steps_stops_the_path() {
     assert_events(&v, &[(0.75, 1, "open", "slip+"), (1.0, 2, "open", "slip-")]);
 }
 
+/// A one-node problem with two non-smooth folds (Klarbring's coupling).
+///
+/// n = 2, A = [[1, ½], [½, 1]] (det D = ¾), N = [1 0], T = [0 1], g = 0, F = 3,
+/// f(α) = (1, α). With B = I, d = A⁻¹(f + λ); write s = fν − ½ ft (so dν = s/D when open).
+/// - open: λ = 0, guard dν = s/D < 0 ⇔ α > 2; there dt = (α − ½)/D > 0;
+/// - slip+: λt = F λν, dν = 0 ⇒ λν (1 − ½F) = −s ⇒ λν = 2s = 2 − α, guard λν < 0 ⇔ α > 2;
+///   dt = (−½(1 + λν) + α + 3 λν)/D = (4.5 − 1.5 α)/D > 0 ⇔ α < 3;
+/// - stick: λ = −f = (−1, −α), guard |α| < F·1 = 3;
+/// - slip−: λt = −F λν ⇒ λν = −s/(1 + ½F) = −(1 − α/2)/2.5, dt = (0.9 + 0.3 α)/D < 0 ⇔ α < −3.
+/// Traced from α = 4 toward −4: open (α decreasing) until α = 2 where contact closes with
+/// dt > 0 into slip+, which exists only for α ∈ (2, 3): α turns back (fold 1); slip+ → stick
+/// at α = 3 where dt reaches 0, and stick exists for α < 3: α turns back again (fold 2);
+/// stick → slip− at α = −3 (no fold). For α ∈ (2, 3) there are three solutions.
+#[test]
+fn hand_two_folds_are_flagged() {
+    let d = TempDir::new("fold");
+    let dir = d.path();
+    std::fs::write(
+        dir.join("A.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n2 2 4\n1 1 1\n1 2 0.5\n2 1 0.5\n2 2 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("N.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n1 2 1\n1 1 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("T.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n1 2 1\n1 2 1\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("f0.txt"), "1\n0\n").unwrap();
+    std::fs::write(dir.join("f1.txt"), "0\n1\n").unwrap();
+    std::fs::write(
+        dir.join("meta.json"),
+        r#"{"n": 2, "p": 1, "F": 3, "alpha_start": 4, "alpha_end": -4}"#,
+    )
+    .unwrap();
+    let (v, table) = trace_json(dir, &[]);
+    assert_events(
+        &v,
+        &[
+            (2.0, 1, "open", "slip+"),
+            (3.0, 1, "slip+", "stick"),
+            (-3.0, 1, "stick", "slip-"),
+        ],
+    );
+    let folds: Vec<bool> = v["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["fold"].as_bool().unwrap())
+        .collect();
+    assert_eq!(folds, [true, true, false]);
+    let dirs: Vec<i64> = v["pieces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["direction"].as_i64().unwrap())
+        .collect();
+    assert_eq!(dirs, [-1, 1, -1, -1]);
+    assert_eq!(v["end"]["alpha"], -4.0);
+    let fold_rows = table.lines().filter(|l| l.ends_with("fold")).count();
+    assert_eq!(fold_rows, 2, "{table}");
+}
+
 // ---------------------------------------------------------------------------------------
 // Bad input: exit status 2 and one line on stderr naming the culprit.
 // ---------------------------------------------------------------------------------------
