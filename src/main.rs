@@ -38,9 +38,11 @@ enum Command {
     /// Trace the solution path of a problem directory (SPEC §7 exchange format).
     Trace(TraceArgs),
     // --- Subcommands of the case study (issue 4), wired by the lead at merge time: ---
-    // GenRect(GenRectArgs)      -> fricont::gen::generate(&RectSpec)?.write_dir(&dir)
-    // CaseStudy(CaseStudyArgs)  -> fricont::casestudy::run(&CaseStudyOptions)
-    // Add the variants here and their arms in `main` below (marked likewise).
+    // GenRect(GenRectArgs)      -> fricont::generator::generate(&RectSpec)?.write_dir(&dir)
+    //                              (the module is `generator`: `gen` is a keyword in 2024)
+    // CaseStudy(CaseStudyArgs)  -> fricont::casestudy::run(&CaseStudyOptions::new(out))
+    // Add the variants here and their arms in `main` below (marked likewise). Map a bad
+    // spec or output directory to `input(..)` (exit 2), other failures to `runtime(..)`.
 }
 
 #[derive(clap::Args, Debug)]
