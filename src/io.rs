@@ -269,7 +269,13 @@ fn parse_meta(path: &FsPath, text: &str) -> Result<Meta> {
     };
     let positive_int = |key: &str| -> Result<usize> {
         let v = get(key)?;
-        match v.as_u64() {
+        // Integers, and floats with an integral value (1320.0, as some writers emit).
+        let as_int = v.as_u64().or_else(|| {
+            v.as_f64()
+                .filter(|x| x.fract() == 0.0 && *x > 0.0 && *x < 9.007_199_254_740_992e15)
+                .map(|x| x as u64)
+        });
+        match as_int {
             Some(x) if x > 0 => usize::try_from(x)
                 .map_err(|_| io_err(path, None, format!("\"{key}\" = {x} is too large"))),
             _ => Err(io_err(
@@ -974,6 +980,11 @@ mod tests {
         assert!(m.contains("\"n\" must be a positive integer"), "{m}");
         let m = broken(
             "meta.json",
+            r#"{"n": 3, "p": 0, "F": 0.5, "alpha_start": -1, "alpha_end": 1}"#,
+        );
+        assert!(m.contains("\"p\" must be a positive integer"), "{m}");
+        let m = broken(
+            "meta.json",
             r#"{"n": 3, "p": 1, "F": [0.5, 1], "alpha_start": -1, "alpha_end": 1}"#,
         );
         assert!(m.contains("\"F\" has 2 values"), "{m}");
@@ -1025,6 +1036,19 @@ mod tests {
             "%%MatrixMarket matrix coordinate real general\n1 3 0\n",
         );
         assert!(m.contains("some row is empty"), "{m}");
+    }
+
+    #[test]
+    fn integral_floats_accepted_for_n_and_p() {
+        let t = TempDir::new("float");
+        write_case(&t.0);
+        std::fs::write(
+            t.0.join("meta.json"),
+            r#"{"n": 3.0, "p": 1.0, "F": 0.5, "alpha_start": 0, "alpha_end": 1}"#,
+        )
+        .unwrap();
+        let c = CaseData::read_dir(&t.0).unwrap();
+        assert_eq!((c.n(), c.p()), (3, 1));
     }
 
     #[test]
