@@ -684,6 +684,20 @@ fn sample_runs_through_the_cli() {
     assert_eq!(v["end"]["reason"], "window");
     let events = v["events"].as_array().unwrap();
     assert!(!events.is_empty(), "the sample has transition points");
+    // The JSON is the library's path, α exactly (serde_json writes round-trip numbers).
+    let case = CaseData::read_dir(&sample_dir()).unwrap();
+    let problem = Arc::new(case.problem(None).unwrap());
+    let opts = PathOptions::window(case.alpha_start, case.alpha_end);
+    let mut path = Path::new(problem, case.load().unwrap(), opts).unwrap();
+    path.start(case.alpha_start, None).unwrap();
+    path.run().unwrap();
+    assert_eq!(path.events().len(), events.len());
+    for (e, j) in path.events().iter().zip(events) {
+        assert_eq!(e.alpha.to_bits(), j["alpha"].as_f64().unwrap().to_bits());
+        assert_eq!(e.node as u64 + 1, j["node"].as_u64().unwrap());
+        assert_eq!(e.from.name(), j["from"].as_str().unwrap());
+        assert_eq!(e.to.name(), j["to"].as_str().unwrap());
+    }
     // Every event has a table row with its 1-based node and its α to 14 digits.
     for e in events {
         let alpha = format!("{:.13e}", e["alpha"].as_f64().unwrap());
