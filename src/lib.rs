@@ -49,6 +49,7 @@ pub mod load;
 pub mod path;
 pub mod piece;
 pub mod problem;
+pub mod report;
 pub mod solve;
 
 pub use class::Class;
