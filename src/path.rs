@@ -267,9 +267,10 @@ fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
-/// Largest number of nodes switching at one point for which all neighbouring pieces are
-/// enumerated (4^k candidates).
-const MAX_ENUMERATED_NODES: usize = 7;
+/// Largest number of neighbouring pieces enumerated at one transition point (the product
+/// over the nodes at a class boundary of the number of classes that fit there; nodes at
+/// the vertex are handled by the directional problem instead).
+const MAX_CANDIDATE_PIECES: usize = 4096;
 
 impl Path {
     /// Binds a load to a problem. Computes the condensed load vectors (one back-solve per
@@ -548,9 +549,12 @@ impl Path {
         let enumerated: Vec<usize> = (0..nodes.len())
             .filter(|&k| !(use_directional && is_vertex[k]))
             .collect();
-        if enumerated.len() > MAX_ENUMERATED_NODES {
+        let combos = enumerated
+            .iter()
+            .fold(1usize, |acc, &k| acc.saturating_mul(options[k].len()));
+        if combos > MAX_CANDIDATE_PIECES {
             return Err(Error::Numerical(format!(
-                "{} nodes are at a class boundary at once at alpha = {:e} (more than {MAX_ENUMERATED_NODES} cannot be enumerated)",
+                "{} nodes are at a class boundary at once at alpha = {:e}: {combos} neighbouring pieces exceed the limit of {MAX_CANDIDATE_PIECES}",
                 enumerated.len(),
                 pt.alpha
             )));
