@@ -78,6 +78,7 @@ fn sine_load_double_crossing_margin_1e_6() {
 /// `margin`: how far the amplitude exceeds the top affine event.
 fn sine_load(margin: f64) {
     let mut done = 0;
+    let mut failures: Vec<String> = Vec::new();
     for seed in (0..200u64).filter(|s| s % 2 == 0) {
         let case = random_case(seed);
         let data = &case.data;
@@ -123,63 +124,79 @@ fn sine_load(margin: f64) {
         let problem = Arc::new(data.problem());
         for (name, load) in loads(data.f0.as_slice(), data.f1.as_slice(), amp) {
             let ctx = format!("seed {seed}, {name}, A = {amp}");
-            let mut path =
-                Path::new(problem.clone(), load, PathOptions::window(0.0, 2.0 * PI)).unwrap();
-            path.start(0.0, None).unwrap();
-            assert_eq!(path.run().unwrap(), EndReason::Window, "{ctx}");
-            let ev = path.events();
-            let show = || {
-                format!(
-                    "expected {:#?}\ngot {:#?}",
-                    expected
-                        .iter()
-                        .map(|x| format!("β {:.15} node {} {} -> {}", x.0, x.1, x.2, x.3))
-                        .collect::<Vec<_>>(),
-                    ev.iter()
-                        .map(|e| format!(
-                            "β {:.15} node {} {} -> {}",
-                            e.alpha, e.node, e.from, e.to
-                        ))
-                        .collect::<Vec<_>>()
-                )
-            };
-            assert_eq!(ev.len(), expected.len(), "{ctx}: {}", show());
-            for (e, x) in ev.iter().zip(&expected) {
-                assert_eq!(
-                    (e.node, e.from, e.to, e.fold),
-                    (x.1, x.2, x.3, false),
-                    "{ctx}: {}",
-                    show()
-                );
-                let phi = amp * e.alpha.sin();
-                assert!(
-                    (phi - x.4).abs() <= 1e-12 * x.4.abs().max(1.0),
-                    "{ctx}: φ(β) = {phi:.17e} at the event, affine event {:.17e}",
-                    x.4
-                );
-                let cond = f64::EPSILON / (amp * x.0.cos()).abs();
-                assert!(
-                    (e.alpha - x.0).abs() <= 1e-12 * x.0.abs().max(1.0) + 4.0 * cond,
-                    "{ctx}: β = {:.17e}, expected {:.17e}",
-                    e.alpha,
-                    x.0
-                );
-                assert!(e.state.residual <= 1e-12, "{ctx}");
-            }
-            // the traced solution follows the affine one: λ(β) = λ_aff(φ(β))
-            for k in 0..40 {
-                let b = 2.0 * PI * (k as f64 + 0.5) / 40.0;
-                let sols = path.solutions_at(b).unwrap();
-                assert_eq!(sols.len(), 1, "{ctx}: β = {b}");
-                let want = &br.solutions_at(amp * b.sin())[0].1;
-                let got = lambda_of(&sols[0].state);
-                assert!(
-                    (want - &got).amax() <= 1e-9 * (1.0 + want.amax()),
-                    "{ctx}: β = {b}"
-                );
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let mut path =
+                    Path::new(problem.clone(), load, PathOptions::window(0.0, 2.0 * PI)).unwrap();
+                path.start(0.0, None).unwrap();
+                assert_eq!(path.run().unwrap(), EndReason::Window, "{ctx}");
+                let ev = path.events();
+                let show = || {
+                    format!(
+                        "expected {:#?}\ngot {:#?}",
+                        expected
+                            .iter()
+                            .map(|x| format!("β {:.15} node {} {} -> {}", x.0, x.1, x.2, x.3))
+                            .collect::<Vec<_>>(),
+                        ev.iter()
+                            .map(|e| format!(
+                                "β {:.15} node {} {} -> {}",
+                                e.alpha, e.node, e.from, e.to
+                            ))
+                            .collect::<Vec<_>>()
+                    )
+                };
+                assert_eq!(ev.len(), expected.len(), "{ctx}: {}", show());
+                for (e, x) in ev.iter().zip(&expected) {
+                    assert_eq!(
+                        (e.node, e.from, e.to, e.fold),
+                        (x.1, x.2, x.3, false),
+                        "{ctx}: {}",
+                        show()
+                    );
+                    let phi = amp * e.alpha.sin();
+                    assert!(
+                        (phi - x.4).abs() <= 1e-12 * x.4.abs().max(1.0),
+                        "{ctx}: φ(β) = {phi:.17e} at the event, affine event {:.17e}",
+                        x.4
+                    );
+                    let cond = f64::EPSILON / (amp * x.0.cos()).abs();
+                    assert!(
+                        (e.alpha - x.0).abs() <= 1e-12 * x.0.abs().max(1.0) + 4.0 * cond,
+                        "{ctx}: β = {:.17e}, expected {:.17e}",
+                        e.alpha,
+                        x.0
+                    );
+                    assert!(e.state.residual <= 1e-12, "{ctx}");
+                }
+                // the traced solution follows the affine one: λ(β) = λ_aff(φ(β))
+                for k in 0..40 {
+                    let b = 2.0 * PI * (k as f64 + 0.5) / 40.0;
+                    let sols = path.solutions_at(b).unwrap();
+                    assert_eq!(sols.len(), 1, "{ctx}: β = {b}");
+                    let want = &br.solutions_at(amp * b.sin())[0].1;
+                    let got = lambda_of(&sols[0].state);
+                    assert!(
+                        (want - &got).amax() <= 1e-9 * (1.0 + want.amax()),
+                        "{ctx}: β = {b}"
+                    );
+                }
+            }));
+            if let Err(e) = r {
+                let msg = e
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .unwrap_or_else(|| "panic".into());
+                failures.push(msg.lines().next().unwrap_or("").to_string());
             }
         }
         done += 1;
     }
     assert!(done >= 10, "only {done} suitable cases");
+    assert!(
+        failures.is_empty(),
+        "{} of {} (case, load form) runs failed:\n{}",
+        failures.len(),
+        3 * done,
+        failures.join("\n")
+    );
 }
