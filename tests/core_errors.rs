@@ -354,11 +354,11 @@ fn symmetry_and_storage() {
 fn not_positive_definite_reports_the_pivot() {
     let n = || dense(1, 4, &[1.0, 0.0, 0.0, 0.0]);
     let t = || dense(1, 4, &[0.0, 1.0, 0.0, 0.0]);
-    // Diagonal with one negative (or zero) entry at row 2: whatever the ordering, the only
-    // non-positive pivot is A(2,2), so the reported row must be 2 (0-based).
-    for bad in [-1.0, 0.0] {
+    // Diagonal with one negative (or zero) entry at row k: whatever the ordering, the only
+    // non-positive pivot is A(k,k), so the reported row must be k (0-based).
+    for (k, bad) in [(2, -1.0), (2, 0.0), (3, -1.0), (0, -1.0)] {
         let mut a = eye(4);
-        a[2 * 4 + 2] = bad;
+        a[k * 4 + k] = bad;
         let a = CsrMatrix::from_triplets(
             "A",
             4,
@@ -366,10 +366,13 @@ fn not_positive_definite_reports_the_pivot() {
             &(0..4).map(|i| (i, i, a[i * 5])).collect::<Vec<_>>(),
         )
         .unwrap();
-        let e = build_err("diag", ProblemBuilder::new(a, Storage::Full, n(), t()));
+        let e = build_err(
+            &format!("diag with A({k},{k}) = {bad}"),
+            ProblemBuilder::new(a, Storage::Full, n(), t()),
+        );
         match e {
             Error::NotSpd { row, pivot } => {
-                assert_eq!(row, 2, "{e}");
+                assert_eq!(row, k, "{e}");
                 assert!(pivot < 4);
             }
             e => panic!("diag({bad}): {e:?}"),
