@@ -38,6 +38,9 @@
 //! # let _ = end;
 //! ```
 
+// Dense linear algebra on small index ranges reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 pub mod class;
 pub mod condense;
 pub mod error;

@@ -10,14 +10,10 @@
 
 use std::sync::Arc;
 
-use faer::Mat;
-
 use crate::class::Class;
 use crate::error::{Error, Result};
 use crate::load::{BoundLoad, Load};
-use crate::piece::{
-    Consts, DenseLu, Guard, displacement_gaps, kernel_vector, orientation, shift_gap,
-};
+use crate::piece::{Consts, DenseLu, Guard, PieceLu, displacement_gaps, shift_gap};
 use crate::problem::Problem;
 use crate::solve::solve_fixed_alpha;
 
@@ -223,6 +219,9 @@ struct Cur {
     alpha: f64,
     /// Tangent (λ̇, α̇), unit in scaled coordinates, oriented along the path.
     t: Vec<f64>,
+    /// Factorisation of the piece Jacobian in scaled coordinates, with the scales.
+    lu: Arc<PieceLu>,
+    scales: (f64, f64),
 }
 
 /// A transition point with its continuations, kept until the next step.
@@ -250,6 +249,8 @@ struct Cand {
     t: Vec<f64>,
     orientation: i8,
     det_sign: i8,
+    lu: Arc<PieceLu>,
+    scales: (f64, f64),
 }
 
 fn sign(x: f64) -> i8 {
@@ -336,7 +337,8 @@ impl Path {
 
     fn state(&mut self, lam: &[f64], alpha: f64, classes: &[Class]) -> Result<State> {
         let f = self.load.force(alpha)?;
-        let u = self.problem.delassus().displacement(&f, lam);
+        let mut u = self.load.displacement(alpha, self.problem.delassus())?;
+        self.problem.delassus().add_compliance(lam, &mut u);
         let residual = crate::piece::residual(&self.problem, &u, lam, &f);
         let p = self.problem.p();
         Ok(State {
@@ -349,28 +351,33 @@ impl Path {
         })
     }
 
-    /// Tangent of piece `classes` at `pt`: unit in the scaled coordinates (λ/S, α/A).
-    /// Returns (t, J) or None when the piece Jacobian has rank < 2p.
-    fn tangent(&self, classes: &[Class], pt: &Point, scale: f64) -> Option<(Vec<f64>, Mat<f64>)> {
+    /// Tangent of piece `classes` at `pt` in raw coordinates, from the factorisation of
+    /// the Jacobian in scaled coordinates (λ/S, α/A) where the tangent is a unit vector.
+    /// Returns (t, factorisation, (S, A)) or None when the Jacobian has rank < 2p.
+    fn tangent(
+        &self,
+        classes: &[Class],
+        pt: &Point,
+        scale: f64,
+    ) -> Option<(Vec<f64>, PieceLu, (f64, f64))> {
         let c = self.consts();
         let m = 2 * c.p;
         let qg = shift_gap(&pt.q, self.problem.gap());
-        let (j, _) = c.jacobian(self.problem.delassus().w(), classes, &qg, &pt.dq, pt.alpha);
+        let (mut js, _) = c.jacobian(self.problem.delassus().w(), classes, &qg, &pt.dq, pt.alpha);
         let a_s = self.alpha_scale();
-        let mut js = j.clone();
         for r in 0..m {
             for col in 0..m {
                 js[(r, col)] *= scale;
             }
             js[(r, m)] *= a_s;
         }
-        let ts = kernel_vector(js.as_ref())?;
-        let mut t = ts;
+        let lu = PieceLu::new(js.as_ref())?;
+        let mut t = lu.t.clone();
         for v in t.iter_mut().take(m) {
             *v *= scale;
         }
         t[m] *= a_s;
-        Some((t, j))
+        Some((t, lu, (scale, a_s)))
     }
 
     /// Values and derivatives along `t` of all guards of `classes` at `pt`.
@@ -462,21 +469,18 @@ impl Path {
             for (k, &i) in nodes.iter().enumerate() {
                 classes[i] = options[k][idx[k]];
             }
-            if let Some((t, j)) = self.tangent(&classes, pt, scale) {
-                let det_sign = {
-                    let m = 2 * self.problem.p();
-                    crate::piece::DenseLu::new(j.as_ref().subcols(0, m)).det_sign
-                };
+            let is_back = back.is_some_and(|(bc, _)| bc == classes.as_slice());
+            // The piece the path came from cannot continue it: its crossing guard
+            // decreases forward, and backward is where the path came from.
+            let tangent = if is_back {
+                None
+            } else {
+                self.tangent(&classes, pt, scale)
+            };
+            if let Some((t, lu, scales)) = tangent {
+                let lu = Arc::new(lu);
                 for s in [1.0, -1.0] {
                     let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
-                    if let Some((bc, bt)) = back
-                        && bc == classes.as_slice()
-                    {
-                        let dot: f64 = ts.iter().zip(bt).map(|(a, b)| a * b).sum();
-                        if dot < 0.0 {
-                            continue;
-                        }
-                    }
                     let enters =
                         self.guard_table(&classes, pt, Some(&ts))
                             .iter()
@@ -492,11 +496,24 @@ impl Path {
                                 }
                             });
                     if enters {
+                        let orientation = if s > 0.0 {
+                            lu.orientation
+                        } else {
+                            -lu.orientation
+                        };
+                        let m = ts.len() - 1;
+                        let det_sign = if ts[m].abs() <= 1e-14 {
+                            0
+                        } else {
+                            orientation * sign(ts[m])
+                        };
                         out.push(Cand {
-                            orientation: orientation(j.as_ref(), &ts),
+                            orientation,
                             classes: classes.clone(),
                             t: ts,
                             det_sign,
+                            lu: lu.clone(),
+                            scales,
                         });
                     }
                 }
@@ -611,6 +628,8 @@ impl Path {
                 lam: pt.lam,
                 alpha,
                 t: cand.t,
+                lu: cand.lu,
+                scales: cand.scales,
             },
             end: None,
             sigma: cand.orientation,
@@ -736,9 +755,11 @@ impl Path {
             }
             (Some((s, g)), _) => {
                 let (lam, alpha) = if self.load.is_affine() {
-                    // bordered solve: [J_S; guard row] (λ, α) = (rhs, −const)
+                    // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
+                    // piece's factorisation) and τ from the guard's equation; no drift
+                    // from earlier points enters.
                     let qg = shift_gap(&pt.q, self.problem.gap());
-                    let (j, rhs) = c.jacobian(w, &cur.classes, &qg, &pt.dq, pt.alpha);
+                    let (_, rhs) = c.jacobian(w, &cur.classes, &qg, &pt.dq, pt.alpha);
                     let form = c.guard_form(g);
                     let mut row = vec![0.0; m + 1];
                     form.row(w, &pt.dq, &mut row);
@@ -750,18 +771,15 @@ impl Path {
                             .map(|(a, b)| a * b)
                             .sum::<f64>()
                         - row[m] * cur.alpha;
-                    let mut bm = Mat::<f64>::zeros(m + 1, m + 1);
-                    for r in 0..m {
-                        for col in 0..=m {
-                            bm[(r, col)] = j[(r, col)];
-                        }
+                    let (sc, a_s) = cur.scales;
+                    let mut xp = cur.lu.particular(&rhs);
+                    for v in xp.iter_mut().take(m) {
+                        *v *= sc;
                     }
-                    for col in 0..=m {
-                        bm[(m, col)] = row[col];
-                    }
-                    let mut b = rhs.clone();
-                    b.push(-c0);
-                    let x = DenseLu::new(bm.as_ref()).solve(&b);
+                    xp[m] *= a_s;
+                    let dot = |x: &[f64]| row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+                    let tau = (-c0 - dot(&xp)) / dot(&cur.t);
+                    let x: Vec<f64> = xp.iter().zip(&cur.t).map(|(a, b)| a + tau * b).collect();
                     if x.iter().all(|v| v.is_finite()) {
                         (x[..m].to_vec(), x[m])
                     } else {
@@ -796,7 +814,7 @@ impl Path {
             )
         };
         let classes = cur.classes.clone();
-        let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<(Guard, f64, f64)>)> {
+        let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<GuardRow>)> {
             let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
             let c = this.consts();
             let qg = shift_gap(&q, this.problem.gap());
@@ -1017,6 +1035,8 @@ impl Path {
             lam: pt.lam.clone(),
             alpha: pt.alpha,
             t: cand.t.clone(),
+            lu: cand.lu.clone(),
+            scales: cand.scales,
         };
         let events = pend.events_start..tr.events.len();
         let closed = tr.entries.iter().any(|(c, l, a)| {
@@ -1197,6 +1217,9 @@ impl Path {
         Ok(out)
     }
 }
+
+/// A guard with its value and its derivative along the tangent.
+type GuardRow = (Guard, f64, f64);
 
 enum Exit {
     Window(Point),
