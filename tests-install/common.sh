@@ -77,7 +77,7 @@ build_reference() {
 compare_events() {
     awk -v rtol="${3:-1e-12}" '
         function abs(x) { return x < 0 ? -x : x }
-        function close(a, b) { return abs(a - b) <= rtol * (abs(b) > 1 ? abs(b) : 1) }
+        function near(a, b) { return abs(a - b) <= rtol * (abs(b) > 1 ? abs(b) : 1) }
         FNR == NR { ref[FNR] = $0; nref = FNR; next }
         {
             ngot = FNR
@@ -86,11 +86,11 @@ compare_events() {
             if ($1 != r[1]) { print "line " FNR ": " $0 " vs " ref[FNR]; bad = 1; next }
             if ($1 == "event") {
                 if ($2 != r[2] || $3 != r[3] || $5 != r[5] || $6 != r[6] || $7 != r[7] ||
-                    $8 != r[8] || $9 != r[9] || !close($4, r[4])) {
+                    $8 != r[8] || $9 != r[9] || !near($4, r[4])) {
                     print "line " FNR ": " $0 " vs " ref[FNR]; bad = 1
                 }
             } else if ($1 == "start") {
-                if (!close($2, r[2])) { print "start: " $2 " vs " r[2]; bad = 1 }
+                if (!near($2, r[2])) { print "start: " $2 " vs " r[2]; bad = 1 }
             } else if ($1 == "end") {
                 if ($2 != r[2] || $3 != r[3]) { print "end: " $0 " vs " ref[FNR]; bad = 1 }
             }
