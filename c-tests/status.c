@@ -10,6 +10,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#ifdef __linux__
+#include <dirent.h>
+#endif
 
 #include "common.h"
 
@@ -523,6 +526,21 @@ static void test_strings(void) {
     CHECK(strcmp(fricont_class_name(42), "unknown") == 0, "unknown class");
 }
 
+/* The library must not start threads in the host program (factorisations and solves run
+ * on the calling thread): after everything above, this process still has one thread. */
+static void test_no_threads_started(void) {
+#ifdef __linux__
+    DIR *d = opendir("/proc/self/task");
+    if (!d) return;
+    int count = 0;
+    struct dirent *e;
+    while ((e = readdir(d)) != NULL)
+        if (e->d_name[0] != '.') count++;
+    closedir(d);
+    CHECK(count == 1, "the library started %d thread(s) in the host process (a thread pool?)", count - 1);
+#endif
+}
+
 int main(void) {
     test_strings();
     test_csr_errors();
@@ -531,5 +549,6 @@ int main(void) {
     test_misuse_and_queries();
     test_callback_failures();
     test_fold();
+    test_no_threads_started();
     return finish("status");
 }
