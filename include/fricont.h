@@ -182,8 +182,10 @@ typedef int32_t fricont_status;
 #endif // __cplusplus
 
 /**
- * Class of a contact node (SPEC §3), as written into `int32_t` class arrays and
- * `fricont_event.from` / `.to`.
+ * Class of a contact node, as written into `int32_t` class arrays and
+ * `fricont_event.from` / `.to`. With d = B u − (g, 0) = (dν, dt) (the normal gap change
+ * and the tangential displacement at the nodes), each class has two equations and
+ * guards that hold strictly inside a smooth piece:
  */
 enum fricont_class
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -303,7 +305,7 @@ typedef struct fricont_path fricont_path;
 
 /**
  * A contact problem: the stiffness A, the contact matrices N and T, friction, gap and
- * the augmentation parameter r (SPEC §1). Opaque.
+ * the augmentation parameter r. Opaque.
  *
  * Created by `fricont_problem_new`, configured by the `fricont_problem_set_*` setters,
  * factorised by `fricont_problem_build` (or implicitly by the first `fricont_path_new_*`
@@ -513,7 +515,8 @@ typedef struct fricont_piece {
      */
     int32_t direction;
     /**
-     * The path's orientation sign, sign det [J; tᵀ] (SPEC §4).
+     * The path's orientation sign, sign det [J; tᵀ] with J = ∂H/∂(λ, α) on the piece and t
+     * its tangent; constant along a path (folds show as a change of `direction`).
      */
     int32_t orientation;
     /**
@@ -690,7 +693,9 @@ fricont_status fricont_problem_set_gap(struct fricont_problem *problem,
 
 /**
  * Sets the augmentation parameter r > 0 (force per length) of the equations H = 0
- * (SPEC §1). Solutions, classes and transition points do not depend on r; it scales the
+ * H1 = A u − f − Nᵀλν − Tᵀλt, H2 = λν − min(λν − r (N u − g), 0),
+ * H3 = λt − P_[−b,b](λt − r T u) with b = max(−F λν, 0).
+ * Solutions, classes and transition points do not depend on r; it scales the
  * rows H2, H3 and so the reported residuals. Default: r = 2p / trace(W), the reciprocal
  * of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ. Changing r keeps the
  * factorisation (no new Cholesky of A).
