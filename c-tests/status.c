@@ -2,8 +2,9 @@
  * problems solved by hand). Each error must come back with its documented code and a
  * specific message, never a crash. Run under valgrind by run.sh.
  *
- * Not provoked here: FRICONT_BIFURCATION / FRICONT_END_BIFURCATION (no hand-made problem
- * with a non-smooth bifurcation yet), FRICONT_ERR_SOLVE_FAILED and FRICONT_ERR_NUMERICAL
+ * Not provoked here: FRICONT_BIFURCATION (a bifurcation with a unique
+ * orientation-preserving branch; the mirror problem below stops instead),
+ * FRICONT_ERR_SOLVE_FAILED and FRICONT_ERR_NUMERICAL
  * (no input is known to make the core fail that way), FRICONT_ERR_PANIC and
  * FRICONT_ERR_POISONED (no panic is reachable; the boundary is tested in Rust,
  * src/ffi/tests.rs). Their strings are checked. */
@@ -526,6 +527,174 @@ static void test_strings(void) {
     CHECK(strcmp(fricont_class_name(42), "unknown") == 0, "unknown class");
 }
 
+/* A mirror-symmetric pair of nodes (found by a search over such pairs, checked here
+ * independently): n = 5 dofs (a1, b1, a2, b2, c), A = I, N1 = a1 - 1.5 c, T1 = b1 - 2 c,
+ * N2 = a2 + 1.5 c, T2 = -b2 + 2 c, F = 1.5, f(alpha) = (alpha - 0.5, -1 - alpha,
+ * alpha - 0.5, 1 + alpha, 0): the mirror a1 <-> a2, b1 <-> -b2, c <-> -c maps the problem
+ * to itself. Both nodes are open until q_n = alpha - 0.5 reaches 0 at alpha = 1/2 for
+ * both at once. There the library must stop with FRICONT_END_BIFURCATION and list
+ * candidate branches that (checked here with W = B B^T and q = B f solved by hand-written
+ * elimination) pass through the point, enter their own region in their direction, and
+ * come in mirror pairs. Choosing each orientation-preserving branch continues the path on
+ * that branch. */
+static void solve4(double M[4][4], double *x) {
+    for (int k = 0; k < 4; k++) {
+        int piv = k;
+        for (int i = k + 1; i < 4; i++)
+            if (fabs(M[i][k]) > fabs(M[piv][k])) piv = i;
+        for (int l = 0; l < 4; l++) {
+            double t = M[k][l];
+            M[k][l] = M[piv][l];
+            M[piv][l] = t;
+        }
+        double t = x[k];
+        x[k] = x[piv];
+        x[piv] = t;
+        for (int i = k + 1; i < 4; i++) {
+            double f = M[i][k] / M[k][k];
+            for (int l = k; l < 4; l++) M[i][l] -= f * M[k][l];
+            x[i] -= f * x[k];
+        }
+    }
+    for (int k = 3; k >= 0; k--) {
+        for (int l = k + 1; l < 4; l++) x[k] -= M[k][l] * x[l];
+        x[k] /= M[k][k];
+    }
+}
+
+/* B rows (nu1, nu2, t1, t2) over (a1, b1, a2, b2, c) and the load */
+static const double mir_b[4][5] = {{1, 0, 0, 0, -1.5}, {0, 0, 1, 0, 1.5}, {0, 1, 0, 0, -2}, {0, 0, 0, -1, 2}};
+static const double mir_f0[5] = {-0.5, -1, -0.5, 1, 0}, mir_f1[5] = {1, -1, 1, 1, 0};
+#define MIR_F 1.5
+
+/* lambda (nu1, nu2, t1, t2) on the piece of classes c at alpha; returns the guard margin
+ * (> 0: strictly inside the piece's region). */
+static double mirror_piece(const int32_t c[2], double alpha, double lam[4]) {
+    double W[4][4], q[4], M[4][4] = {{0}};
+    for (int i = 0; i < 4; i++) {
+        q[i] = 0;
+        for (int k = 0; k < 5; k++) q[i] += mir_b[i][k] * (mir_f0[k] + alpha * mir_f1[k]);
+        for (int j = 0; j < 4; j++) {
+            W[i][j] = 0;
+            for (int k = 0; k < 5; k++) W[i][j] += mir_b[i][k] * mir_b[j][k];
+        }
+    }
+    for (int i = 0; i < 2; i++) {
+        int rn = i, rt = 2 + i;
+        lam[rn] = 0;
+        lam[rt] = 0;
+        if (c[i] == FRICONT_OPEN) {
+            M[rn][i] = 1;
+            M[rt][2 + i] = 1;
+            continue;
+        }
+        for (int j = 0; j < 4; j++) M[rn][j] = W[i][j];
+        lam[rn] = -q[i];
+        if (c[i] == FRICONT_STICK) {
+            for (int j = 0; j < 4; j++) M[rt][j] = W[2 + i][j];
+            lam[rt] = -q[2 + i];
+        } else {
+            M[rt][2 + i] = 1;
+            M[rt][i] = c[i] == FRICONT_SLIP_PLUS ? -MIR_F : MIR_F;
+        }
+    }
+    solve4(M, lam);
+    double margin = INFINITY;
+    for (int i = 0; i < 2; i++) {
+        double dn = q[i], dt = q[2 + i];
+        for (int j = 0; j < 4; j++) {
+            dn += W[i][j] * lam[j];
+            dt += W[2 + i][j] * lam[j];
+        }
+        double ln = lam[i], lt = lam[2 + i], g;
+        switch (c[i]) {
+        case FRICONT_OPEN: g = -dn; break;
+        case FRICONT_STICK: g = fmin(-ln, fmin(lt - MIR_F * ln, -MIR_F * ln - lt)); break;
+        case FRICONT_SLIP_PLUS: g = fmin(-ln, dt); break;
+        default: g = fmin(-ln, -dt);
+        }
+        margin = fmin(margin, g);
+    }
+    return margin;
+}
+
+static fricont_path *mirror_path(void) {
+    int64_t arp[] = {0, 1, 2, 3, 4, 5}, aci[] = {0, 1, 2, 3, 4};
+    double av[] = {1, 1, 1, 1, 1};
+    int64_t nrp[] = {0, 2, 4}, nci[] = {0, 4, 2, 4}, trp[] = {0, 2, 4}, tci[] = {1, 4, 3, 4};
+    double nv[] = {1, -1.5, 1, 1.5}, tv[] = {1, -2, -1, 2};
+    fricont_csr a = mk(5, 5, 5, arp, aci, av, 0), n = mk(2, 5, 4, nrp, nci, nv, 0), t = mk(2, 5, 4, trp, tci, tv, 0);
+    fricont_problem *p = NULL;
+    fricont_path *path = NULL;
+    EXPECT(fricont_problem_new(&a, FRICONT_STORAGE_FULL, &n, &t, &p), FRICONT_OK, "");
+    EXPECT(fricont_problem_set_friction(p, MIR_F), FRICONT_OK, "");
+    EXPECT(fricont_path_new_affine(p, mir_f0, mir_f1, 5, &path), FRICONT_OK, "");
+    fricont_problem_free(p);
+    fricont_path_set_window(path, -3.0, 3.0);
+    EXPECT(fricont_path_start(path, -3.0, NULL, 0), FRICONT_OK, "");
+    return path;
+}
+
+static void test_bifurcation(void) {
+    fricont_path *path = mirror_path();
+    int32_t reason = -1;
+    EXPECT(fricont_path_step(path), FRICONT_END, "");
+    EXPECT(fricont_path_end_reason(path, &reason), FRICONT_OK, "");
+    CHECK(reason == FRICONT_END_BIFURCATION, "end reason %d, expected FRICONT_END_BIFURCATION", reason);
+    fricont_state s = {0, 0, NULL, 0, NULL, 0, NULL, 0, NULL, 0};
+    EXPECT(fricont_path_current(path, &s), FRICONT_OK, "");
+    CHECK(fabs(s.alpha - 0.5) < 1e-14, "stopped at alpha %.17g, expected 1/2", s.alpha);
+    int64_t nb = 0;
+    EXPECT(fricont_path_branch_count(path, &nb), FRICONT_OK, "");
+    CHECK(nb >= 2, "%lld branches", (long long)nb);
+    int32_t cls[8][2];
+    fricont_branch br[8];
+    int preserving = 0;
+    for (int64_t k = 0; k < nb && k < 8; k++) {
+        EXPECT(fricont_path_branch(path, k, &br[k], cls[k], 2), FRICONT_OK, "");
+        double lam[4];
+        double at = mirror_piece(cls[k], 0.5, lam);
+        CHECK(fabs(lam[0]) + fabs(lam[1]) + fabs(lam[2]) + fabs(lam[3]) < 1e-12 && at > -1e-12,
+              "branch %lld (%s, %s) does not pass through the point", (long long)k,
+              fricont_class_name(cls[k][0]), fricont_class_name(cls[k][1]));
+        CHECK(br[k].direction != 0, "a vertical branch");
+        double inside = mirror_piece(cls[k], 0.5 + 1e-3 * br[k].direction, lam);
+        CHECK(inside > 0, "branch %lld (%s, %s) does not enter its region in direction %d (margin %g)",
+              (long long)k, fricont_class_name(cls[k][0]), fricont_class_name(cls[k][1]), br[k].direction, inside);
+        preserving += br[k].orientation_preserving;
+        int mirrored = 0;
+        for (int64_t j = 0; j < nb && j < 8; j++) {
+            int32_t cj[2];
+            fricont_path_branch(path, j, NULL, cj, 2);
+            mirrored += cj[0] == cls[k][1] && cj[1] == cls[k][0];
+        }
+        CHECK(mirrored == 1, "the mirror image of branch %lld is listed once (%d)", (long long)k, mirrored);
+    }
+    CHECK(preserving != 1, "stopped although exactly one branch preserves the orientation");
+    EXPECT(fricont_path_choose_branch(path, nb), FRICONT_ERR_RANGE, "branch index");
+    fricont_path_free(path);
+    /* each branch, chosen on a fresh path, is followed */
+    for (int64_t k = 0; k < nb && k < 8; k++) {
+        path = mirror_path();
+        EXPECT(fricont_path_step(path), FRICONT_END, "");
+        EXPECT(fricont_path_choose_branch(path, k), FRICONT_OK, "");
+        fricont_status st = fricont_path_step(path);
+        CHECK(st > 0, "step after choosing branch %lld: %s", (long long)k, fricont_status_str(st));
+        int64_t np = 0;
+        fricont_path_piece_count(path, &np);
+        int32_t c[2] = {-1, -1};
+        fricont_piece pc;
+        fricont_path_piece(path, 1, &pc, c, 2);
+        CHECK(np >= 2 && c[0] == cls[k][0] && c[1] == cls[k][1] && pc.direction == br[k].direction &&
+                  fabs(pc.alpha_from - 0.5) < 1e-14,
+              "branch %lld: the second piece is (%s, %s) direction %d", (long long)k, fricont_class_name(c[0]),
+              fricont_class_name(c[1]), pc.direction);
+        double lam[4];
+        CHECK(mirror_piece(c, 0.5 * (pc.alpha_from + pc.alpha_to), lam) > 0, "branch %lld: the piece is valid", (long long)k);
+        fricont_path_free(path);
+    }
+}
+
 /* The library must not start threads in the host program (factorisations and solves run
  * on the calling thread): after everything above, this process still has one thread. */
 static void test_no_threads_started(void) {
@@ -549,6 +718,7 @@ int main(void) {
     test_misuse_and_queries();
     test_callback_failures();
     test_fold();
+    test_bifurcation();
     test_no_threads_started();
     return finish("status");
 }
