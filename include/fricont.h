@@ -182,8 +182,10 @@ typedef int32_t fricont_status;
 #endif // __cplusplus
 
 /**
- * Class of a contact node (SPEC §3), as written into `int32_t` class arrays and
- * `fricont_event.from` / `.to`.
+ * Class of a contact node, as written into `int32_t` class arrays and
+ * `fricont_event.from` / `.to`. With d = B u − (g, 0) = (dν, dt) (the normal gap change
+ * and the tangential displacement at the nodes), each class has two equations and
+ * guards that hold strictly inside a smooth piece:
  */
 enum fricont_class
 #if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
@@ -303,7 +305,7 @@ typedef struct fricont_path fricont_path;
 
 /**
  * A contact problem: the stiffness A, the contact matrices N and T, friction, gap and
- * the augmentation parameter r (SPEC §1). Opaque.
+ * the augmentation parameter r. Opaque.
  *
  * Created by `fricont_problem_new`, configured by the `fricont_problem_set_*` setters,
  * factorised by `fricont_problem_build` (or implicitly by the first `fricont_path_new_*`
@@ -314,6 +316,47 @@ typedef struct fricont_path fricont_path;
  * functions may be called from several threads at once.
  */
 typedef struct fricont_problem fricont_problem;
+
+/**
+ * A sparse matrix in compressed sparse row (CSR) form, as the caller stores it. The
+ * library only reads it during the call that receives it and copies what it needs.
+ *
+ * Row `i` (0-based position) holds the entries `row_ptr[i] - index_base ..
+ * row_ptr[i+1] - index_base` (0-based positions in `col_idx` and `values`); the column
+ * numbers in `col_idx` count from `index_base` too. Within a row the columns may come in
+ * any order but must not repeat (duplicates are rejected, not summed).
+ */
+typedef struct fricont_csr {
+    /**
+     * Number of rows, ≥ 0.
+     */
+    int64_t nrows;
+    /**
+     * Number of columns, ≥ 0.
+     */
+    int64_t ncols;
+    /**
+     * Number of stored entries: the length of `col_idx` and `values`, and
+     * `row_ptr[nrows] - index_base`.
+     */
+    int64_t nnz;
+    /**
+     * `nrows + 1` row pointers, `row_ptr[0] == index_base`, non-decreasing.
+     */
+    const int64_t *row_ptr;
+    /**
+     * `nnz` column indices (NULL allowed when `nnz == 0`).
+     */
+    const int64_t *col_idx;
+    /**
+     * `nnz` values (NULL allowed when `nnz == 0`), finite.
+     */
+    const double *values;
+    /**
+     * 0 (C) or 1 (Fortran, MATLAB).
+     */
+    int64_t index_base;
+} fricont_csr;
 
 /**
  * A basis-weights callback for `f(α) = Σ_j φ_j(α) f_j`: writes `φ_j(α)` into `phi[0..k)`
@@ -472,7 +515,8 @@ typedef struct fricont_piece {
      */
     int32_t direction;
     /**
-     * The path's orientation sign, sign det [J; tᵀ] (SPEC §4).
+     * The path's orientation sign, sign det [J; tᵀ] with J = ∂H/∂(λ, α) on the piece and t
+     * its tangent; constant along a path (folds show as a change of `direction`).
      */
     int32_t orientation;
     /**
@@ -510,50 +554,221 @@ typedef struct fricont_solution {
     bool continuum;
 } fricont_solution;
 
-/**
- * A sparse matrix in compressed sparse row (CSR) form, as the caller stores it. The
- * library only reads it during the call that receives it and copies what it needs.
- *
- * Row `i` (0-based position) holds the entries `row_ptr[i] - index_base ..
- * row_ptr[i+1] - index_base` (0-based positions in `col_idx` and `values`); the column
- * numbers in `col_idx` count from `index_base` too. Within a row the columns may come in
- * any order but must not repeat (duplicates are rejected, not summed).
- */
-typedef struct fricont_csr {
-    /**
-     * Number of rows, ≥ 0.
-     */
-    int64_t nrows;
-    /**
-     * Number of columns, ≥ 0.
-     */
-    int64_t ncols;
-    /**
-     * Number of stored entries: the length of `col_idx` and `values`, and
-     * `row_ptr[nrows] - index_base`.
-     */
-    int64_t nnz;
-    /**
-     * `nrows + 1` row pointers, `row_ptr[0] == index_base`, non-decreasing.
-     */
-    const int64_t *row_ptr;
-    /**
-     * `nnz` column indices (NULL allowed when `nnz == 0`).
-     */
-    const int64_t *col_idx;
-    /**
-     * `nnz` values (NULL allowed when `nnz == 0`), finite.
-     */
-    const double *values;
-    /**
-     * 0 (C) or 1 (Fortran, MATLAB).
-     */
-    int64_t index_base;
-} fricont_csr;
-
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+/**
+ * A static, NUL-terminated description of a status code: the enumerator's name, a colon
+ * and one line (e.g. `"FRICONT_ERR_NULL: a required pointer argument is NULL"`).
+ *
+ * `status` is any `int32_t`; an unknown code gives `"unknown fricont status code"`.
+ * The returned string is owned by the library, valid forever; never free it.
+ * Thread-safe.
+ */
+const char *fricont_status_str(int32_t status);
+
+/**
+ * The name of a class code (`fricont_class`): `"open"`, `"stick"`, `"slip+"`, `"slip-"`
+ * (the names of the JSON exchange format), or `"unknown"` for any other value.
+ *
+ * The returned string is static (never free it). Thread-safe.
+ */
+const char *fricont_class_name(int32_t class_code);
+
+/**
+ * The library's version, `"MAJOR.MINOR.PATCH"` (static, NUL-terminated; never free it).
+ * Compare with `FRICONT_VERSION_MAJOR` etc. to detect a header that does not match the
+ * library you linked. Thread-safe.
+ */
+const char *fricont_version(void);
+
+/**
+ * Copies the calling thread's last error message (set by every failing call on this
+ * thread, including constructors that have no handle yet and calls given a NULL handle)
+ * into `buf`, with `snprintf` semantics.
+ *
+ * * `buf`: caller-owned, may be NULL (then nothing is written).
+ * * `len`: size of `buf` in bytes; at most `len - 1` bytes and a terminating NUL are
+ *   written (the text is cut at a UTF-8 character boundary; messages are UTF-8).
+ *
+ * Returns the full length of the message in bytes, not counting the NUL (0 when no call
+ * on this thread has failed yet): a return value `≥ len` means the text was cut.
+ * A successful call does not clear the message.
+ *
+ * # Safety
+ * `buf` is NULL or valid for `len` bytes of writes.
+ */
+size_t fricont_last_error_message(char *buf,
+                                  size_t len);
+
+/**
+ * Creates a problem from the stiffness matrix A and the contact matrices N and T.
+ *
+ * * `a`: A (n×n), symmetric positive definite with the Dirichlet dofs eliminated, in
+ *   the storage given by `a_storage`. Not NULL.
+ * * `a_storage`: `FRICONT_STORAGE_FULL`, `_LOWER` or `_UPPER` (`fricont_storage`).
+ * * `n`, `t`: N and T (p×n, p ≥ 1, 2p ≤ n): row i gives the outward normal and the
+ *   tangential displacement of contact node i, so that `(N u)_i ≤ g_i` is
+ *   non-penetration. Not NULL.
+ * * `out`: receives the new handle (NULL on failure). Not NULL.
+ *
+ * All arrays are read during the call and copied; the caller keeps ownership. The CSR
+ * structure, the dimensions and finiteness are checked here; symmetry, positive
+ * definiteness of A and the rank of B = [N; T] when the problem is built. Defaults of
+ * the settings: F = 0 (frictionless), gap g = 0, r = 2p / trace(W) (see
+ * `fricont_problem_r`).
+ *
+ * Returns `FRICONT_OK`; `FRICONT_ERR_NULL` (a NULL argument or array);
+ * `FRICONT_ERR_LENGTH` (negative sizes, A not square, N or T not p×n, p = 0);
+ * `FRICONT_ERR_RANGE` (unknown `a_storage`); `FRICONT_ERR_CSR` (malformed CSR, index base
+ * not 0/1); `FRICONT_ERR_NONFINITE` (NaN or infinity in a value); `FRICONT_ERR_PANIC`.
+ * The message is in `fricont_last_error_message`.
+ *
+ * # Safety
+ * Each pointer is NULL or valid as described; arrays have the lengths the CSR structs
+ * state.
+ */
+fricont_status fricont_problem_new(const struct fricont_csr *a,
+                                   int32_t a_storage,
+                                   const struct fricont_csr *n,
+                                   const struct fricont_csr *t,
+                                   struct fricont_problem **out);
+
+/**
+ * Frees a problem handle. NULL is a no-op. Paths created from it stay valid (they hold
+ * their own reference to the factorised data). Never use the handle afterwards.
+ *
+ * # Safety
+ * `problem` is NULL or a handle from `fricont_problem_new` not freed before.
+ */
+void fricont_problem_free(struct fricont_problem *problem);
+
+/**
+ * Sets the same friction coefficient F (dimensionless, finite, ≥ 0) at every node.
+ * Default 0 (frictionless). A change drops the factorisation: the next build (explicit or
+ * by `fricont_path_new_*`) factorises A again; existing paths are not affected.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (F < 0 or not
+ * finite; the setting is then unchanged), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle.
+ */
+fricont_status fricont_problem_set_friction(struct fricont_problem *problem,
+                                            double friction);
+
+/**
+ * Sets one friction coefficient per contact node: `friction[i]` (finite, ≥ 0) for node i
+ * (0-based), `len` must equal p. The array is copied. Default: 0 at every node. A change
+ * drops the factorisation as for `fricont_problem_set_friction`.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`, or `friction` with `len > 0`),
+ * `FRICONT_ERR_LENGTH` (`len ≠ p`), `FRICONT_ERR_RANGE` (a value < 0 or not finite; the
+ * message names the node), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle; `friction` is NULL or valid for `len` reads.
+ */
+fricont_status fricont_problem_set_friction_nodes(struct fricont_problem *problem,
+                                                  const double *friction,
+                                                  int64_t len);
+
+/**
+ * Sets the initial normal gap g (p values, length units of u): node i is in contact when
+ * `(N u)_i = g_i`. `gap` NULL (with any `len`) restores the default g = 0; otherwise
+ * `len` must equal p. The array is copied. A change drops the factorisation as for
+ * `fricont_problem_set_friction`.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_LENGTH` (`len ≠ p`),
+ * `FRICONT_ERR_NONFINITE` (a NaN or infinity; the message names the node),
+ * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle; `gap` is NULL or valid for `len` reads.
+ */
+fricont_status fricont_problem_set_gap(struct fricont_problem *problem,
+                                       const double *gap,
+                                       int64_t len);
+
+/**
+ * Sets the augmentation parameter r > 0 (force per length) of the equations H = 0
+ * H1 = A u − f − Nᵀλν − Tᵀλt, H2 = λν − min(λν − r (N u − g), 0),
+ * H3 = λt − P_[−b,b](λt − r T u) with b = max(−F λν, 0).
+ * Solutions, classes and transition points do not depend on r; it scales the
+ * rows H2, H3 and so the reported residuals. Default: r = 2p / trace(W), the reciprocal
+ * of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ. Changing r keeps the
+ * factorisation (no new Cholesky of A).
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (r ≤ 0 or not
+ * finite), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle.
+ */
+fricont_status fricont_problem_set_r(struct fricont_problem *problem,
+                                     double r);
+
+/**
+ * Validates and factorises the problem now: checks the symmetry of A (full storage),
+ * computes a sparse Cholesky factorisation of A and the Delassus operator
+ * W = B A⁻¹ Bᵀ (one solve with 2p right-hand sides), and checks that W is positive
+ * definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
+ * needed; call it to see data errors early or to time the set-up. A no-op when nothing
+ * changed since the last build.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_NOT_SYMMETRIC`,
+ * `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
+ * the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n),
+ * `FRICONT_ERR_NUMERICAL` (out of memory), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle.
+ */
+fricont_status fricont_problem_build(struct fricont_problem *problem);
+
+/**
+ * The dimensions: `*n` receives the number of dofs n, `*p` the number of contact nodes
+ * p. Each output pointer may be NULL (not written). Does not build.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_POISONED`,
+ * `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle; `n`, `p` are NULL or valid for one write.
+ */
+fricont_status fricont_problem_dims(const struct fricont_problem *problem,
+                                    int64_t *n,
+                                    int64_t *p);
+
+/**
+ * The augmentation parameter in use (`*r`) and its data-derived default 2p / trace(W)
+ * (`*default_r`), both force per length. Builds the problem if needed (so it returns the
+ * build's errors too). Each output pointer may be NULL.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), the errors of
+ * `fricont_problem_build`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle; `r`, `default_r` are NULL or valid for one write.
+ */
+fricont_status fricont_problem_r(struct fricont_problem *problem,
+                                 double *r,
+                                 double *default_r);
+
+/**
+ * Copies the message of the most recent failing call on this problem handle into `buf`
+ * with `snprintf` semantics (at most `len - 1` bytes and a NUL, cut at a UTF-8 character
+ * boundary; nothing written when `buf` is NULL or `len` is 0). Returns the full message
+ * length in bytes without the NUL (0 if no call on the handle has failed; also 0 for a
+ * NULL handle). Works on a poisoned handle.
+ *
+ * # Safety
+ * `problem` is NULL or a live handle; `buf` is NULL or valid for `len` bytes of writes.
+ */
+size_t fricont_problem_error_message(const struct fricont_problem *problem,
+                                     char *buf,
+                                     size_t len);
 
 /**
  * Creates a path with the affine load `f(α) = f0 + α f1` on a problem (building the
@@ -969,216 +1184,6 @@ fricont_status fricont_path_solution(const struct fricont_path *path,
  */
 size_t fricont_path_error_message(const struct fricont_path *path,
                                   char *buf,
-                                  size_t len);
-
-/**
- * Creates a problem from the stiffness matrix A and the contact matrices N and T.
- *
- * * `a`: A (n×n), symmetric positive definite with the Dirichlet dofs eliminated, in
- *   the storage given by `a_storage`. Not NULL.
- * * `a_storage`: `FRICONT_STORAGE_FULL`, `_LOWER` or `_UPPER` (`fricont_storage`).
- * * `n`, `t`: N and T (p×n, p ≥ 1, 2p ≤ n): row i gives the outward normal and the
- *   tangential displacement of contact node i, so that `(N u)_i ≤ g_i` is
- *   non-penetration. Not NULL.
- * * `out`: receives the new handle (NULL on failure). Not NULL.
- *
- * All arrays are read during the call and copied; the caller keeps ownership. The CSR
- * structure, the dimensions and finiteness are checked here; symmetry, positive
- * definiteness of A and the rank of B = [N; T] when the problem is built. Defaults of
- * the settings: F = 0 (frictionless), gap g = 0, r = 2p / trace(W) (see
- * `fricont_problem_r`).
- *
- * Returns `FRICONT_OK`; `FRICONT_ERR_NULL` (a NULL argument or array);
- * `FRICONT_ERR_LENGTH` (negative sizes, A not square, N or T not p×n, p = 0);
- * `FRICONT_ERR_RANGE` (unknown `a_storage`); `FRICONT_ERR_CSR` (malformed CSR, index base
- * not 0/1); `FRICONT_ERR_NONFINITE` (NaN or infinity in a value); `FRICONT_ERR_PANIC`.
- * The message is in `fricont_last_error_message`.
- *
- * # Safety
- * Each pointer is NULL or valid as described; arrays have the lengths the CSR structs
- * state.
- */
-fricont_status fricont_problem_new(const struct fricont_csr *a,
-                                   int32_t a_storage,
-                                   const struct fricont_csr *n,
-                                   const struct fricont_csr *t,
-                                   struct fricont_problem **out);
-
-/**
- * Frees a problem handle. NULL is a no-op. Paths created from it stay valid (they hold
- * their own reference to the factorised data). Never use the handle afterwards.
- *
- * # Safety
- * `problem` is NULL or a handle from `fricont_problem_new` not freed before.
- */
-void fricont_problem_free(struct fricont_problem *problem);
-
-/**
- * Sets the same friction coefficient F (dimensionless, finite, ≥ 0) at every node.
- * Default 0 (frictionless). A change drops the factorisation: the next build (explicit or
- * by `fricont_path_new_*`) factorises A again; existing paths are not affected.
- *
- * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (F < 0 or not
- * finite; the setting is then unchanged), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
- *
- * # Safety
- * `problem` is NULL or a live handle.
- */
-fricont_status fricont_problem_set_friction(struct fricont_problem *problem,
-                                            double friction);
-
-/**
- * Sets one friction coefficient per contact node: `friction[i]` (finite, ≥ 0) for node i
- * (0-based), `len` must equal p. The array is copied. Default: 0 at every node. A change
- * drops the factorisation as for `fricont_problem_set_friction`.
- *
- * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`, or `friction` with `len > 0`),
- * `FRICONT_ERR_LENGTH` (`len ≠ p`), `FRICONT_ERR_RANGE` (a value < 0 or not finite; the
- * message names the node), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
- *
- * # Safety
- * `problem` is NULL or a live handle; `friction` is NULL or valid for `len` reads.
- */
-fricont_status fricont_problem_set_friction_nodes(struct fricont_problem *problem,
-                                                  const double *friction,
-                                                  int64_t len);
-
-/**
- * Sets the initial normal gap g (p values, length units of u): node i is in contact when
- * `(N u)_i = g_i`. `gap` NULL (with any `len`) restores the default g = 0; otherwise
- * `len` must equal p. The array is copied. A change drops the factorisation as for
- * `fricont_problem_set_friction`.
- *
- * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_LENGTH` (`len ≠ p`),
- * `FRICONT_ERR_NONFINITE` (a NaN or infinity; the message names the node),
- * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
- *
- * # Safety
- * `problem` is NULL or a live handle; `gap` is NULL or valid for `len` reads.
- */
-fricont_status fricont_problem_set_gap(struct fricont_problem *problem,
-                                       const double *gap,
-                                       int64_t len);
-
-/**
- * Sets the augmentation parameter r > 0 (force per length) of the equations H = 0
- * (SPEC §1). Solutions, classes and transition points do not depend on r; it scales the
- * rows H2, H3 and so the reported residuals. Default: r = 2p / trace(W), the reciprocal
- * of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ. Changing r keeps the
- * factorisation (no new Cholesky of A).
- *
- * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (r ≤ 0 or not
- * finite), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
- *
- * # Safety
- * `problem` is NULL or a live handle.
- */
-fricont_status fricont_problem_set_r(struct fricont_problem *problem,
-                                     double r);
-
-/**
- * Validates and factorises the problem now: checks the symmetry of A (full storage),
- * computes a sparse Cholesky factorisation of A and the Delassus operator
- * W = B A⁻¹ Bᵀ (one solve with 2p right-hand sides), and checks that W is positive
- * definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
- * needed; call it to see data errors early or to time the set-up. A no-op when nothing
- * changed since the last build.
- *
- * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_NOT_SYMMETRIC`,
- * `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
- * the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n),
- * `FRICONT_ERR_NUMERICAL` (out of memory), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
- *
- * # Safety
- * `problem` is NULL or a live handle.
- */
-fricont_status fricont_problem_build(struct fricont_problem *problem);
-
-/**
- * The dimensions: `*n` receives the number of dofs n, `*p` the number of contact nodes
- * p. Each output pointer may be NULL (not written). Does not build.
- *
- * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_POISONED`,
- * `FRICONT_ERR_PANIC`.
- *
- * # Safety
- * `problem` is NULL or a live handle; `n`, `p` are NULL or valid for one write.
- */
-fricont_status fricont_problem_dims(const struct fricont_problem *problem,
-                                    int64_t *n,
-                                    int64_t *p);
-
-/**
- * The augmentation parameter in use (`*r`) and its data-derived default 2p / trace(W)
- * (`*default_r`), both force per length. Builds the problem if needed (so it returns the
- * build's errors too). Each output pointer may be NULL.
- *
- * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), the errors of
- * `fricont_problem_build`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
- *
- * # Safety
- * `problem` is NULL or a live handle; `r`, `default_r` are NULL or valid for one write.
- */
-fricont_status fricont_problem_r(struct fricont_problem *problem,
-                                 double *r,
-                                 double *default_r);
-
-/**
- * Copies the message of the most recent failing call on this problem handle into `buf`
- * with `snprintf` semantics (at most `len - 1` bytes and a NUL, cut at a UTF-8 character
- * boundary; nothing written when `buf` is NULL or `len` is 0). Returns the full message
- * length in bytes without the NUL (0 if no call on the handle has failed; also 0 for a
- * NULL handle). Works on a poisoned handle.
- *
- * # Safety
- * `problem` is NULL or a live handle; `buf` is NULL or valid for `len` bytes of writes.
- */
-size_t fricont_problem_error_message(const struct fricont_problem *problem,
-                                     char *buf,
-                                     size_t len);
-
-/**
- * A static, NUL-terminated description of a status code: the enumerator's name, a colon
- * and one line (e.g. `"FRICONT_ERR_NULL: a required pointer argument is NULL"`).
- *
- * `status` is any `int32_t`; an unknown code gives `"unknown fricont status code"`.
- * The returned string is owned by the library, valid forever; never free it.
- * Thread-safe.
- */
-const char *fricont_status_str(int32_t status);
-
-/**
- * The name of a class code (`fricont_class`): `"open"`, `"stick"`, `"slip+"`, `"slip-"`
- * (the names of the JSON exchange format), or `"unknown"` for any other value.
- *
- * The returned string is static (never free it). Thread-safe.
- */
-const char *fricont_class_name(int32_t class_code);
-
-/**
- * The library's version, `"MAJOR.MINOR.PATCH"` (static, NUL-terminated; never free it).
- * Compare with `FRICONT_VERSION_MAJOR` etc. to detect a header that does not match the
- * library you linked. Thread-safe.
- */
-const char *fricont_version(void);
-
-/**
- * Copies the calling thread's last error message (set by every failing call on this
- * thread, including constructors that have no handle yet and calls given a NULL handle)
- * into `buf`, with `snprintf` semantics.
- *
- * * `buf`: caller-owned, may be NULL (then nothing is written).
- * * `len`: size of `buf` in bytes; at most `len - 1` bytes and a terminating NUL are
- *   written (the text is cut at a UTF-8 character boundary; messages are UTF-8).
- *
- * Returns the full length of the message in bytes, not counting the NUL (0 when no call
- * on this thread has failed yet): a return value `≥ len` means the text was cut.
- * A successful call does not clear the message.
- *
- * # Safety
- * `buf` is NULL or valid for `len` bytes of writes.
- */
-size_t fricont_last_error_message(char *buf,
                                   size_t len);
 
 #ifdef __cplusplus

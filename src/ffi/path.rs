@@ -129,7 +129,8 @@ pub struct fricont_piece {
     /// Sign of dα/ds on the piece: +1, −1, or 0 for a vertical piece (a continuum of
     /// solutions at one α).
     pub direction: i32,
-    /// The path's orientation sign, sign det [J; tᵀ] (SPEC §4).
+    /// The path's orientation sign, sign det [J; tᵀ] with J = ∂H/∂(λ, α) on the piece and t
+    /// its tangent; constant along a path (folds show as a change of `direction`).
     pub orientation: i32,
     /// Sign of det ∂H/∂λ on the piece (0 if singular).
     pub det_sign: i32,

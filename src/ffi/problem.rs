@@ -39,7 +39,7 @@ pub struct fricont_csr {
 }
 
 /// A contact problem: the stiffness A, the contact matrices N and T, friction, gap and
-/// the augmentation parameter r (SPEC §1). Opaque.
+/// the augmentation parameter r. Opaque.
 ///
 /// Created by `fricont_problem_new`, configured by the `fricont_problem_set_*` setters,
 /// factorised by `fricont_problem_build` (or implicitly by the first `fricont_path_new_*`
@@ -357,7 +357,9 @@ pub unsafe extern "C" fn fricont_problem_set_gap(
 }
 
 /// Sets the augmentation parameter r > 0 (force per length) of the equations H = 0
-/// (SPEC §1). Solutions, classes and transition points do not depend on r; it scales the
+/// H1 = A u − f − Nᵀλν − Tᵀλt, H2 = λν − min(λν − r (N u − g), 0),
+/// H3 = λt − P_[−b,b](λt − r T u) with b = max(−F λν, 0).
+/// Solutions, classes and transition points do not depend on r; it scales the
 /// rows H2, H3 and so the reported residuals. Default: r = 2p / trace(W), the reciprocal
 /// of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ. Changing r keeps the
 /// factorisation (no new Cholesky of A).

@@ -159,8 +159,10 @@ impl fricont_status {
     }
 }
 
-/// Class of a contact node (SPEC §3), as written into `int32_t` class arrays and
-/// `fricont_event.from` / `.to`.
+/// Class of a contact node, as written into `int32_t` class arrays and
+/// `fricont_event.from` / `.to`. With d = B u − (g, 0) = (dν, dt) (the normal gap change
+/// and the tangential displacement at the nodes), each class has two equations and
+/// guards that hold strictly inside a smooth piece:
 #[repr(i32)]
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[allow(non_camel_case_types)]
