@@ -12,6 +12,17 @@ ensure_release || { fail "cargo build --release"; finish; }
 run_check "C reference events (tests-install/trace_case.c)" build_reference
 
 M=$ROOT/matlab
+VERSION=$(sed -n 's/^version *= *"\([0-9.]*\)".*/\1/p' "$ROOT/Cargo.toml" | head -1)
+
+# scripts/install.sh, then fricont_build.m from the installed copy, in Octave.
+build_from_install() {
+    need_cmd patchelf patchelf || return 1
+    bash "$ROOT/scripts/install.sh" "$WORK/prefix" >/dev/null || return 1
+    mkdir -p "$WORK/built"
+    octave --no-gui --norc --no-window-system --eval \
+        "addpath('$WORK/prefix/share/fricont/matlab'); fricont_build('$WORK/prefix', '$WORK/built'); \
+         addpath('$WORK/built'); exit(double(~strcmp(fricont_mex('version'), '$VERSION')))"
+}
 cd "$WORK" || exit 1
 run_check "fricont_mex.c compiles warning-free (-Wall -Wextra -Werror)" \
     gcc -std=c11 -fsyntax-only -Wall -Wextra -Werror $(mkoctfile -p INCFLAGS) \
@@ -31,6 +42,8 @@ if ls "$WORK"/fricont_mex.mex* >/dev/null 2>&1 && [ -f ref.txt ]; then
     FAILED=$((FAILED + $(grep -c '^FAIL ' oct.txt)))
     [ "$rc" -eq 0 ] || [ "$(grep -c '^FAIL ' oct.txt)" -gt 0 ] || fail "octave exited with $rc"
     grep -q 'matlab test_fricont:' oct.txt || fail "test_fricont.m ran to its end"
+    run_check "fricont_build(prefix, outdir) builds the gateway from an installed copy" \
+        build_from_install
     run_check "affine load: events equal the C interface's" compare_events ref.txt affine.txt 1e-12
     run_check "A as its lower triangle (storage 'lower'): same events" \
         compare_events ref.txt lower.txt 1e-12

@@ -12,21 +12,21 @@ function failures = test_fricont(case_dir, out_dir)
   % 1. Affine load.
   path = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts);
   write_events(fullfile(out_dir, 'affine.txt'), path, @(a) a);
-  failures += check('affine: ends at the window', strcmp(path.end_reason, 'window'));
-  failures += check('affine: pieces = events + 1', numel(path.pieces) == numel(path.events) + 1);
-  failures += check('handle locks the MEX file', fricont_mex('is_locked'));
+  failures = failures + check('affine: ends at the window', strcmp(path.end_reason, 'window'));
+  failures = failures + check('affine: pieces = events + 1', numel(path.pieces) == numel(path.events) + 1);
+  failures = failures + check('handle locks the MEX file', fricont_mex('is_locked'));
   ev = path.events;
 
   % 2. Solutions between the first two events satisfy the equations (checked here).
   alpha = (ev(1).alpha + ev(2).alpha) / 2;
   S = fricont_solutions_at(path, alpha);
-  failures += check('solutions_at: one solution on piece 2', numel(S) == 1 && S(1).piece == 2);
+  failures = failures + check('solutions_at: one solution on piece 2', numel(S) == 1 && S(1).piece == 2);
   f = c.f0 + alpha * c.f1;
   [ok, why] = check_solution(c, S(1), f);
-  failures += check('solutions_at: equilibrium and contact conditions', ok, why);
+  failures = failures + check('solutions_at: equilibrium and contact conditions', ok, why);
   [ok, why] = check_solution(c, ev(1), c.f0 + ev(1).alpha * c.f1);
-  failures += check('event state: equilibrium and contact conditions', ok, why);
-  failures += check('solutions_at: none outside the traced range', ...
+  failures = failures + check('event state: equilibrium and contact conditions', ok, why);
+  failures = failures + check('solutions_at: none outside the traced range', ...
                     isempty(fricont_solutions_at(path, c.alpha_end + 1)));
 
   % 3. A load given as a function handle, f(s) = f0 + sinh(s) f1, with and without
@@ -38,7 +38,7 @@ function failures = test_fricont(case_dir, out_dir)
   ph2 = fricont_trace(c.A, c.N, c.T, @(s) c.f0 + sinh(s) * c.f1, [], c.F, swin, opts);
   write_events(fullfile(out_dir, 'handle_nodf.txt'), ph2, @sinh);
   Sh = fricont_solutions_at(ph, asinh(alpha));
-  failures += check('solutions_at through a load function: same u', numel(Sh) == 1 && ...
+  failures = failures + check('solutions_at through a load function: same u', numel(Sh) == 1 && ...
                     norm(Sh(1).u - S(1).u, inf) <= 1e-8 * norm(S(1).u, inf));
 
   % 4. The lower triangle of A with storage 'lower' gives the same path.
@@ -49,8 +49,8 @@ function failures = test_fricont(case_dir, out_dir)
   % 5. An error in the load function: raised by fricont_trace, after the library call
   %    returned; nothing is left allocated.
   clear path ph ph2 pl;
-  failures += check('every handle freed when the structs are cleared', fricont_mex('count') == 0);
-  failures += check('MEX file unlocked without handles', ~fricont_mex('is_locked'));
+  failures = failures + check('every handle freed when the structs are cleared', fricont_mex('count') == 0);
+  failures = failures + check('MEX file unlocked without handles', ~fricont_mex('is_locked'));
   stop = (ev(2).alpha + ev(3).alpha) / 2;
   msg = '';
   try
@@ -59,17 +59,17 @@ function failures = test_fricont(case_dir, out_dir)
     msg = err.message;
     ident = err.identifier;
   end
-  failures += check('load function error: raised as fricont:load', ...
+  failures = failures + check('load function error: raised as fricont:load', ...
                     ~isempty(msg) && strcmp(ident, 'fricont:load') && ...
                     ~isempty(strfind(msg, 'load not defined past the stop')), msg);
-  failures += check('load function error: nothing left allocated', fricont_mex('count') == 0);
+  failures = failures + check('load function error: nothing left allocated', fricont_mex('count') == 0);
   msg = '';
   try
     fricont_trace(c.A, c.N, c.T, @(a) ones(3, 1), [], c.F, win, opts);
   catch err
     msg = err.message;
   end
-  failures += check('load function of the wrong length: clear error', ...
+  failures = failures + check('load function of the wrong length: clear error', ...
                     ~isempty(strfind(msg, 'real vector of n = ')), msg);
 
   % 6. Bad input: library errors with their status as identifier.
@@ -80,7 +80,7 @@ function failures = test_fricont(case_dir, out_dir)
     ident = err.identifier;
     msg = err.message;
   end
-  failures += check('N with a wrong column count: fricont:ERR_LENGTH', ...
+  failures = failures + check('N with a wrong column count: fricont:ERR_LENGTH', ...
                     strcmp(ident, 'fricont:ERR_LENGTH'), [ident ' ' msg]);
   ident = '';
   try
@@ -88,21 +88,21 @@ function failures = test_fricont(case_dir, out_dir)
   catch err
     ident = err.identifier;
   end
-  failures += check('negative friction: fricont:ERR_RANGE', strcmp(ident, 'fricont:ERR_RANGE'), ident);
+  failures = failures + check('negative friction: fricont:ERR_RANGE', strcmp(ident, 'fricont:ERR_RANGE'), ident);
   ident = '';
   try
     fricont_mex('path_result', uint64(123456));
   catch err
     ident = err.identifier;
   end
-  failures += check('unknown handle: fricont:handle', strcmp(ident, 'fricont:handle'), ident);
+  failures = failures + check('unknown handle: fricont:handle', strcmp(ident, 'fricont:handle'), ident);
   ident = '';
   try
     fricont_mex('path_result', 3);
   catch err
     ident = err.identifier;
   end
-  failures += check('handle of the wrong class: fricont:handle', strcmp(ident, 'fricont:handle'), ident);
+  failures = failures + check('handle of the wrong class: fricont:handle', strcmp(ident, 'fricont:handle'), ident);
 
   % 7. A request MATLAB abandons (as after Ctrl-C) does not hang or leak: freeing the
   %    handle ends the pending library call.
@@ -112,9 +112,9 @@ function failures = test_fricont(case_dir, out_dir)
   fricont_mex('free', prob);
   fricont_mex('path_set', id, 'window', win);
   [what, value] = fricont_mex('path_call', id, 'start', win(1), []);
-  failures += check('a load request reaches MATLAB', strcmp(what, 'f') && value == win(1), what);
+  failures = failures + check('a load request reaches MATLAB', strcmp(what, 'f') && value == win(1), what);
   fricont_mex('free', id);
-  failures += check('abandoned request: handle freed', fricont_mex('count') == 0);
+  failures = failures + check('abandoned request: handle freed', fricont_mex('count') == 0);
   fprintf('matlab test_fricont: %d failed check(s)\n', failures);
 end
 
