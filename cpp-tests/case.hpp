@@ -49,7 +49,8 @@ inline Csr read_mtx(const std::string &path) {
     std::ifstream in = open(path);
     std::string line;
     std::getline(in, line);
-    if (line.rfind("%%MatrixMarket", 0) != 0) throw std::runtime_error(path + ": not Matrix Market");
+    if (line.rfind("%%MatrixMarket", 0) != 0)
+        throw std::runtime_error(path + ": not Matrix Market");
     Csr m;
     m.symmetric = line.find("symmetric") != std::string::npos;
     while (std::getline(in, line) && line[0] == '%') {

@@ -15,7 +15,7 @@ run_check "fricont.h compiles as C++ alone" \
             -Wl,-rpath,'$LIBDIR' -o '$WORK/h_only' && '$WORK/h_only'"
 run_check "test_wrapper.cpp compiles (-Werror)" \
     g++ $CXXFLAGS -I"$ROOT/include" "$ROOT/cpp-tests/test_wrapper.cpp" \
-    -L"$LIBDIR" -lfricont -Wl,-rpath,"$LIBDIR" -o "$WORK/test_wrapper"
+    -L"$LIBDIR" -lfricont -Wl,-rpath,"$LIBDIR" -pthread -o "$WORK/test_wrapper"
 
 if [ -x "$WORK/test_wrapper" ] && [ -f "$WORK/ref.txt" ]; then
     "$WORK/test_wrapper" "$CASE" "$WORK/ref.txt" >"$WORK/out.txt" 2>&1

@@ -16,6 +16,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
@@ -98,13 +99,16 @@ std::string check_solution(const casefile::Case &c, const fricont::State &s,
     std::vector<double> au = c.a.apply(s.u), ntl = c.n.apply_t(s.lambda_n),
                         ttl = c.t.apply_t(s.lambda_t);
     double fscale = 0, res = 0;
-    for (std::size_t i = 0; i < n; i++) fscale = std::max({fscale, std::fabs(f[i]), std::fabs(au[i])});
-    for (std::size_t i = 0; i < n; i++) res = std::max(res, std::fabs(au[i] - f[i] - ntl[i] - ttl[i]));
+    for (std::size_t i = 0; i < n; i++) {
+        fscale = std::max({fscale, std::fabs(f[i]), std::fabs(au[i])});
+        res = std::max(res, std::fabs(au[i] - f[i] - ntl[i] - ttl[i]));
+    }
     if (res > 1e-9 * fscale) return "equilibrium residual " + std::to_string(res / fscale);
     std::vector<double> nu = c.n.apply(s.u), tu = c.t.apply(s.u);
     double lscale = 0, lam = 0;
     for (double x : s.u) lscale = std::max(lscale, std::fabs(x));
-    for (std::size_t i = 0; i < p; i++) lam = std::max({lam, std::fabs(s.lambda_n[i]), std::fabs(s.lambda_t[i])});
+    for (std::size_t i = 0; i < p; i++)
+        lam = std::max({lam, std::fabs(s.lambda_n[i]), std::fabs(s.lambda_t[i])});
     const double tl = 1e-9 * lscale, tf = 1e-9 * lam;
     for (std::size_t i = 0; i < p; i++) {
         double dn = nu[i] - c.gap[i], dt = tu[i], ln = s.lambda_n[i], lt = s.lambda_t[i];
@@ -120,7 +124,8 @@ std::string check_solution(const casefile::Case &c, const fricont::State &s,
             ok = ok && std::fabs(dn) <= tl && std::fabs(lt + fr * ln) <= tf && dt <= tl;
             break;
         }
-        if (!ok) return "node " + std::to_string(i + 1) + " violates " + fricont::name(s.classes[i]);
+        if (!ok)
+            return "node " + std::to_string(i + 1) + " violates " + fricont::name(s.classes[i]);
     }
     return "";
 }
@@ -212,8 +217,10 @@ int main(int argc, char **argv) {
         fricont::EndReason r = g.run();
         std::vector<fricont::Event> gev = g.events();
         std::string d = compare(gev, ref, 1e-9, [](double a) { return std::asinh(a); }, ref.size());
-        report("general load: ends at the window", r == fricont::EndReason::Window, fricont::name(r));
-        report("general load: events at asinh(reference)", d.empty() && gev.size() == ref.size(), d);
+        report("general load: ends at the window", r == fricont::EndReason::Window,
+               fricont::name(r));
+        report("general load: events at asinh(reference)",
+               d.empty() && gev.size() == ref.size(), d);
     }
 
     // 5. An exception thrown by a load callback comes back out of the wrapper call (it
@@ -249,7 +256,34 @@ int main(int argc, char **argv) {
         report("callback exception: later step returns End", again);
     }
 
-    // 6. Errors of the library are exceptions with the status and the message.
+    // 6. Distinct paths on one problem traced from two threads at once give the same
+    //    events (the handles share no mutable state).
+    {
+        std::vector<fricont::Event> got[2];
+        std::string failure[2];
+        auto work = [&](int k) {
+            try {
+                fricont::Path t = fricont::Path::affine(prob, c.f0, c.f1);
+                t.set_window(c.alpha_start, c.alpha_end);
+                t.start(c.alpha_start);
+                t.run();
+                got[k] = t.events();
+            } catch (const std::exception &e) {
+                failure[k] = e.what();
+            }
+        };
+        std::thread t0(work, 0), t1(work, 1);
+        t0.join();
+        t1.join();
+        std::string d0 = compare(got[0], ref, 0.0, same, ref.size());
+        std::string d1 = compare(got[1], ref, 0.0, same, ref.size());
+        report("two threads: both paths give the reference events",
+               failure[0].empty() && failure[1].empty() && d0.empty() && d1.empty() &&
+                   got[0].size() == ref.size() && got[1].size() == ref.size(),
+               failure[0] + failure[1] + d0 + d1);
+    }
+
+    // 7. Errors of the library are exceptions with the status and the message.
     {
         std::vector<int64_t> ptr{0, 1, 2}, idx{0, 7};
         std::vector<double> val{1.0, 1.0};

@@ -14,7 +14,8 @@
 !> * Errors: every procedure has an optional `type(fricont_error), intent(out) :: err`
 !>   (the fortran-lang/stdlib convention): when present it receives the status and the
 !>   library's message; when absent, a failing call stops the program with the message
-!>   (written to stderr, then `error stop 1`). Step outcomes (`FRICONT_TRANSITION`, ... `FRICONT_END`) are not errors.
+!>   (written to stderr, then `error stop 1`). Step outcomes (`FRICONT_TRANSITION`, ...,
+!>   `FRICONT_END`) are not errors.
 !> * Handles are freed by `free` or by the final procedure when the variable goes out of
 !>   scope (not at the end of a main program: call `free` there). Do not copy a problem
 !>   or path variable with `=`: intrinsic assignment would share the handle (the defined

@@ -67,7 +67,7 @@ if command -v g++ >/dev/null 2>&1; then
     run_check "C++ wrapper test via pkg-config (installed fricont.hpp)" \
         bash -c "g++ -std=c++17 -Wall -Wextra -Wpedantic -Werror -I'$ROOT/cpp-tests' \
             '$ROOT/cpp-tests/test_wrapper.cpp' \$(pkg-config --cflags --libs fricont) $RPATH \
-            -o pc_cpp && ./pc_cpp '$CASE' ref.txt"
+            -pthread -o pc_cpp && ./pc_cpp '$CASE' ref.txt"
 fi
 if command -v gfortran >/dev/null 2>&1; then
     run_check "Fortran module from the installed source via pkg-config" \

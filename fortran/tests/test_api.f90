@@ -249,7 +249,8 @@ contains
         evb = basis%events()
         same = size(evb) == size(ev)
         if (same) same = all(evb%node == ev%node) .and. &
-                         all(abs(sinh(evb%alpha) - ev%alpha) <= 1e-9_real64*max(1.0_real64, abs(ev%alpha)))
+                         all(abs(sinh(evb%alpha) - ev%alpha) <= &
+                             1e-9_real64*max(1.0_real64, abs(ev%alpha)))
         call check('basis load: events at asinh of the affine ones', same)
 
         ! Misuse through err: starting outside the window, a wrong guess length.
@@ -261,7 +262,8 @@ contains
                    err%status == FRICONT_ERR_LENGTH, err%message)
         call prob%set_friction(-1.0_real64, err=err)
         call check('negative friction: FRICONT_ERR_RANGE', err%status == FRICONT_ERR_RANGE)
-        call check('status name', index(fricont_status_name(FRICONT_ERR_CSR), 'FRICONT_ERR_CSR') == 1)
+        call check('status name', &
+                   index(fricont_status_name(FRICONT_ERR_CSR), 'FRICONT_ERR_CSR') == 1)
     end subroutine run_all
 
 end program test_api
