@@ -48,6 +48,7 @@
 pub mod class;
 pub mod condense;
 pub mod error;
+pub mod ffi;
 pub mod io;
 pub mod load;
 pub mod path;
