@@ -341,9 +341,11 @@ impl Path {
     }
 
     fn state(&mut self, lam: &[f64], alpha: f64, classes: &[Class]) -> Result<State> {
+        // One back-solve of f + Bᵀλ: forming u as A⁻¹f + (A⁻¹Bᵀ)λ instead would cancel
+        // (the free displacement under the load is often orders of magnitude larger than
+        // u) and lose the residual's accuracy.
         let f = self.load.force(alpha)?;
-        let mut u = self.load.displacement(alpha, self.problem.delassus())?;
-        self.problem.delassus().add_compliance(lam, &mut u);
+        let u = self.problem.delassus().displacement(&f, lam);
         let residual = crate::piece::residual(&self.problem, &u, lam, &f);
         let p = self.problem.p();
         Ok(State {
@@ -1093,8 +1095,12 @@ impl Path {
                 Ok(out)
             }
             None => {
-                // record the transition point as an event-less stop; the user chooses
-                self.trace.as_mut().expect("started").pending = Some(pending);
+                // Stop at the bifurcation point; its events are recorded when the caller
+                // chooses a branch.
+                let tr = self.trace.as_mut().expect("started");
+                tr.cur.lam = pending.point.lam.clone();
+                tr.cur.alpha = pending.point.alpha;
+                tr.pending = Some(pending);
                 Ok(self.finish(EndReason::Bifurcation))
             }
         }
