@@ -2,8 +2,9 @@
  * problems solved by hand). Each error must come back with its documented code and a
  * specific message, never a crash. Run under valgrind by run.sh.
  *
- * Not provoked here: FRICONT_BIFURCATION (a bifurcation with a unique
- * orientation-preserving branch; the mirror problem below stops instead),
+ * Not provoked here: FRICONT_BIFURCATION (several continuing pieces of which exactly one
+ * preserves the orientation: index theory makes this rare, and 100000 random
+ * mirror-symmetric pairs gave only stops, FRICONT_END_BIFURCATION, tested below),
  * FRICONT_ERR_SOLVE_FAILED and FRICONT_ERR_NUMERICAL
  * (no input is known to make the core fail that way), FRICONT_ERR_PANIC and
  * FRICONT_ERR_POISONED (no panic is reachable; the boundary is tested in Rust,

@@ -422,8 +422,11 @@ pub unsafe extern "C" fn fricont_path_new_basis(
                     return Err(Failure::length("k = 0: a basis load needs at least one vector"));
                 }
                 let weights = weights.ok_or_else(|| Failure::null("weights (the callback)"))?;
+                let total = len
+                    .checked_mul(k)
+                    .ok_or_else(|| Failure::length(format!("n * k = {len} * {k} overflows")))?;
                 // SAFETY: NULL or valid for `n*k` reads, by contract.
-                let all = unsafe { slice_in(vectors, len * k, "vectors") }?;
+                let all = unsafe { slice_in(vectors, total, "vectors") }?;
                 let vecs: Vec<Vec<f64>> = all.chunks(len.max(1)).map(|c| c.to_vec()).collect();
                 let ud = ud.clone();
                 let f = move |alpha: f64, phi: &mut [f64], dphi: &mut [f64]| {
