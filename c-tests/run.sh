@@ -111,6 +111,12 @@ run "loads and threads: Q1 example" "$OUT/paths" "$Q1"
 if command -v valgrind >/dev/null; then
     VG=(valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite)
     run "valgrind header C99" "${VG[@]}" "$OUT/header_c"
+    run "valgrind header C++17" "${VG[@]}" "$OUT/header_cpp"
+    if "${VG[@]}" "$OUT/q1_rectangle" >"$OUT/valgrind_q1.txt" 2>&1; then
+        pass "valgrind examples-c/q1_rectangle"
+    else
+        fail "valgrind examples-c/q1_rectangle"; tail -30 "$OUT/valgrind_q1.txt"
+    fi
     run "valgrind status codes" "${VG[@]}" "$OUT/status"
     run "valgrind CHOLMOD reference: Q1 example" "${VG[@]}" "$OUT/cholmod_ref" "$Q1"
     run "valgrind loads and threads: Q1 example" "${VG[@]}" "$OUT/paths" "$Q1"

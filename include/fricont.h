@@ -917,7 +917,7 @@ fricont_status fricont_path_set_zero_tol(struct fricont_path *path,
 
 /**
  * Starts (or restarts) the path at `alpha` with the fixed-α solver (semi-smooth Newton
- * with globalisation), from the contact forces `guess` = (λν, λt) or, if `guess` is
+ * with a line search, then projected block Gauss–Seidel if that stalls), from the contact forces `guess` = (λν, λt) or, if `guess` is
  * NULL, from zero forces. A restart clears the events and pieces traced so far. The load
  * callbacks may be called.
  *

@@ -422,8 +422,11 @@ pub unsafe extern "C" fn fricont_path_new_basis(
                     return Err(Failure::length("k = 0: a basis load needs at least one vector"));
                 }
                 let weights = weights.ok_or_else(|| Failure::null("weights (the callback)"))?;
+                let total = len
+                    .checked_mul(k)
+                    .ok_or_else(|| Failure::length(format!("n * k = {len} * {k} overflows")))?;
                 // SAFETY: NULL or valid for `n*k` reads, by contract.
-                let all = unsafe { slice_in(vectors, len * k, "vectors") }?;
+                let all = unsafe { slice_in(vectors, total, "vectors") }?;
                 let vecs: Vec<Vec<f64>> = all.chunks(len.max(1)).map(|c| c.to_vec()).collect();
                 let ud = ud.clone();
                 let f = move |alpha: f64, phi: &mut [f64], dphi: &mut [f64]| {
@@ -613,7 +616,7 @@ pub unsafe extern "C" fn fricont_path_set_zero_tol(
 }
 
 /// Starts (or restarts) the path at `alpha` with the fixed-α solver (semi-smooth Newton
-/// with globalisation), from the contact forces `guess` = (λν, λt) or, if `guess` is
+/// with a line search, then projected block Gauss–Seidel if that stalls), from the contact forces `guess` = (λν, λt) or, if `guess` is
 /// NULL, from zero forces. A restart clears the events and pieces traced so far. The load
 /// callbacks may be called.
 ///
