@@ -41,6 +41,7 @@
 pub mod class;
 pub mod condense;
 pub mod error;
+pub mod generator;
 pub mod io;
 pub mod load;
 pub mod path;
