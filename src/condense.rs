@@ -13,9 +13,7 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError as DenseLltError;
-use faer::sparse::linalg::cholesky::{
-    LltRef, SymbolicCholesky, factorize_symbolic_cholesky,
-};
+use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 
@@ -47,13 +45,8 @@ impl Delassus {
     pub fn new(a_lower: &CsrMatrix, b: &CsrMatrix) -> Result<Self> {
         let n = a_lower.nrows();
         // CSR of the lower triangle == CSC of the upper triangle.
-        let symb = SymbolicSparseColMatRef::new_checked(
-            n,
-            n,
-            a_lower.row_ptr(),
-            None,
-            a_lower.col_idx(),
-        );
+        let symb =
+            SymbolicSparseColMatRef::new_checked(n, n, a_lower.row_ptr(), None, a_lower.col_idx());
         let a_csc = SparseColMatRef::new(symb, a_lower.values());
         let symbolic =
             factorize_symbolic_cholesky(symb, Side::Upper, Default::default(), Default::default())

@@ -20,7 +20,9 @@ pub enum Error {
     #[error("A is not symmetric: {0}")]
     NotSymmetric(String),
     /// The Cholesky factorisation of A met a non-positive pivot.
-    #[error("A is not positive definite: non-positive pivot at (0-based) position {pivot} of the fill-reducing ordering, original row {row}")]
+    #[error(
+        "A is not positive definite: non-positive pivot at (0-based) position {pivot} of the fill-reducing ordering, original row {row}"
+    )]
     NotSpd {
         /// Pivot position in the permuted order.
         pivot: usize,

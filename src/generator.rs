@@ -227,7 +227,11 @@ impl RectSpec {
                 self.nx, self.ny
             ));
         }
-        if self.nx.checked_mul(self.ny).is_none_or(|m| m > (1usize << 40)) {
+        if self
+            .nx
+            .checked_mul(self.ny)
+            .is_none_or(|m| m > (1usize << 40))
+        {
             return bad(format!("mesh {} × {} is too large", self.nx, self.ny));
         }
         for (name, v) in [
@@ -419,9 +423,7 @@ pub(crate) fn add_tractions(
             for c in 0..2 {
                 let (ta, tb) = (value(e, c), value(e + 1, c));
                 let (fa, fb) = match spec.rule {
-                    ForceRule::Consistent => {
-                        (h * (2.0 * ta + tb) / 6.0, h * (ta + 2.0 * tb) / 6.0)
-                    }
+                    ForceRule::Consistent => (h * (2.0 * ta + tb) / 6.0, h * (ta + 2.0 * tb) / 6.0),
                     ForceRule::Trapezoid => (h * ta / 2.0, h * tb / 2.0),
                 };
                 if let Some(d) = dof(nodes[e].0, nodes[e].1) {
@@ -704,7 +706,11 @@ mod tests {
         add_tractions(&spec, &ts, &move |i, j| Some(2 * (j * nx + i)), &mut f);
         for i in 0..m {
             let ku: f64 = (0..m).map(|j| k[i * m + j] * u[j]).sum();
-            assert!((ku - f[i]).abs() < 1e-13, "dof {i}: K u = {ku}, f = {}", f[i]);
+            assert!(
+                (ku - f[i]).abs() < 1e-13,
+                "dof {i}: K u = {ku}, f = {}",
+                f[i]
+            );
         }
     }
 

@@ -38,6 +38,7 @@
 //! # let _ = end;
 //! ```
 
+pub mod casestudy;
 pub mod class;
 pub mod condense;
 pub mod error;

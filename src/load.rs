@@ -32,8 +32,7 @@ pub struct LoadFailure {
 }
 
 /// `f(α)` into the output slice (n entries).
-pub type VectorFn =
-    Box<dyn FnMut(f64, &mut [f64]) -> std::result::Result<(), LoadFailure> + Send>;
+pub type VectorFn = Box<dyn FnMut(f64, &mut [f64]) -> std::result::Result<(), LoadFailure> + Send>;
 /// Basis weights: `(α, φ_out, φ'_out)` with k entries each.
 pub type WeightsFn =
     Box<dyn FnMut(f64, &mut [f64], &mut [f64]) -> std::result::Result<(), LoadFailure> + Send>;
@@ -203,7 +202,11 @@ impl BoundLoad {
     /// The load vector `f(α)` (n entries).
     pub(crate) fn force(&mut self, alpha: f64) -> Result<Vec<f64>> {
         match &mut self.load {
-            Load::Affine { f0, f1 } => Ok(f0.iter().zip(f1.iter()).map(|(a, b)| a + alpha * b).collect()),
+            Load::Affine { f0, f1 } => Ok(f0
+                .iter()
+                .zip(f1.iter())
+                .map(|(a, b)| a + alpha * b)
+                .collect()),
             Load::Basis { .. } => {
                 self.eval_weights(alpha)?;
                 let Load::Basis { vectors, .. } = &self.load else {

@@ -68,12 +68,18 @@ fn generator_reproduces_the_sample_case() {
         for i in 0..m.nrows() {
             for (j, v) in m.row(i) {
                 let w = dense.get(&(i, j)).copied().unwrap_or(0.0);
-                assert!((v - w).abs() <= 1e-12 * scale, "{name}({i},{j}): {v} vs {w}");
+                assert!(
+                    (v - w).abs() <= 1e-12 * scale,
+                    "{name}({i},{j}): {v} vs {w}"
+                );
                 seen += usize::from(dense.contains_key(&(i, j)));
             }
         }
         let nonzero = dense.values().filter(|v| v.abs() > 1e-12 * scale).count();
-        assert!(seen >= nonzero, "{name}: sample has entries outside the pattern");
+        assert!(
+            seen >= nonzero,
+            "{name}: sample has entries outside the pattern"
+        );
     }
     for (name, f) in [("f0", &c.f0), ("f1", &c.f1)] {
         let s = read_vec(&dir.join(format!("{name}.txt")));
