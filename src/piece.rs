@@ -1,1 +1,433 @@
 //! Smooth pieces (SPEC §3–4): piece equations, guards, tangents and orientation.
+//!
+//! Everything here works in the condensed variables `λ = (λν, λt) ∈ R^{2p}` and α, with
+//! `d = q(α) + W λ − (g, 0)`. Both the piece equations and the guards of a node are
+//! *linear forms* in `(λ, d)`: `Σ a_j λ_j + Σ b_j d_j`. Substituting `d` gives rows over
+//! `(λ, α)`:
+//!
+//! ```text
+//! row_λ = a + bᵀ W,   row_α = bᵀ q'(α),   constant = bᵀ (q(α) − (g, 0)) − row_α α
+//! ```
+//!
+//! so a piece `S` is the solution set of `J_S (λ, α) = const`, `J_S ∈ R^{2p×(2p+1)}`, with
+//! the seed's rows: `r dν` for a contact node and `λν` for an open one; `r dt` for stick,
+//! `λt ∓ F λν` for slip±, `λt` for open. Guards are scaled to force units: displacement
+//! guards are multiplied by the problem's default `r` (which depends on the data only), so
+//! that tolerances and the reported geometry never depend on the user's `r`.
+
+use faer::{Mat, MatRef};
+
+use crate::class::Class;
+use crate::problem::Problem;
+
+/// A linear form `Σ a_j λ_j + Σ b_j d_j` with at most two λ terms and one d term.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LinForm {
+    pub a: [(usize, f64); 2],
+    pub b: (usize, f64),
+}
+
+impl LinForm {
+    fn lam(i: usize, c: f64) -> Self {
+        Self {
+            a: [(i, c), (0, 0.0)],
+            b: (0, 0.0),
+        }
+    }
+    fn lam2(i: usize, c: f64, j: usize, e: f64) -> Self {
+        Self {
+            a: [(i, c), (j, e)],
+            b: (0, 0.0),
+        }
+    }
+    fn disp(i: usize, c: f64) -> Self {
+        Self {
+            a: [(0, 0.0), (0, 0.0)],
+            b: (i, c),
+        }
+    }
+    /// Value at `(λ, d)`; also the derivative along `(λ̇, ḋ)` (the forms are homogeneous).
+    pub fn eval(&self, lam: &[f64], d: &[f64]) -> f64 {
+        self.a[0].1 * lam[self.a[0].0] + self.a[1].1 * lam[self.a[1].0] + self.b.1 * d[self.b.0]
+    }
+    /// Row over `(λ, α)` (length m + 1) given W and `q'`.
+    pub fn row(&self, w: MatRef<'_, f64>, dq: &[f64], out: &mut [f64]) {
+        let m = w.nrows();
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for &(j, c) in &self.a {
+            out[j] += c;
+        }
+        let (j, c) = self.b;
+        if c != 0.0 {
+            for k in 0..m {
+                out[k] += c * w[(j, k)];
+            }
+            out[m] = c * dq[j];
+        }
+    }
+}
+
+/// The inequalities that hold strictly inside a piece, as "value > 0".
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(crate) enum GuardKind {
+    /// Open: `−dν > 0`.
+    Gap,
+    /// Contact: `−λν > 0`.
+    Compress,
+    /// Stick: `λt − F λν > 0` (reaching 0: slip+).
+    ConeUpper,
+    /// Stick: `−F λν − λt > 0` (reaching 0: slip−).
+    ConeLower,
+    /// Slip+: `dt > 0`.
+    SlipPos,
+    /// Slip−: `−dt > 0`.
+    SlipNeg,
+}
+
+/// A guard of one node.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(crate) struct Guard {
+    pub node: usize,
+    pub kind: GuardKind,
+}
+
+/// The guards of a class.
+pub(crate) fn guard_kinds(c: Class) -> &'static [GuardKind] {
+    use GuardKind::*;
+    match c {
+        Class::Open => &[Gap],
+        Class::Stick => &[Compress, ConeUpper, ConeLower],
+        Class::SlipPlus => &[Compress, SlipPos],
+        Class::SlipMinus => &[Compress, SlipNeg],
+    }
+}
+
+/// Problem constants the forms need.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Consts<'a> {
+    pub p: usize,
+    pub friction: &'a [f64],
+    /// The user's r (equation rows).
+    pub r: f64,
+    /// The default r (guard scaling).
+    pub r0: f64,
+}
+
+impl<'a> Consts<'a> {
+    pub fn of(problem: &'a Problem) -> Self {
+        Self {
+            p: problem.p(),
+            friction: problem.friction(),
+            r: problem.r(),
+            r0: problem.default_r(),
+        }
+    }
+
+    /// The guard as a linear form in force units.
+    pub fn guard_form(&self, g: Guard) -> LinForm {
+        let (i, p, f, r0) = (g.node, self.p, self.friction[g.node], self.r0);
+        match g.kind {
+            GuardKind::Gap => LinForm::disp(i, -r0),
+            GuardKind::Compress => LinForm::lam(i, -1.0),
+            GuardKind::ConeUpper => LinForm::lam2(p + i, 1.0, i, -f),
+            GuardKind::ConeLower => LinForm::lam2(p + i, -1.0, i, -f),
+            GuardKind::SlipPos => LinForm::disp(p + i, r0),
+            GuardKind::SlipNeg => LinForm::disp(p + i, -r0),
+        }
+    }
+
+    /// The two piece equations of node `i` in class `c`: (ν-row, t-row), the seed's rows.
+    pub fn equations(&self, i: usize, c: Class) -> [LinForm; 2] {
+        let (p, f, r) = (self.p, self.friction[i], self.r);
+        let nu = match c {
+            Class::Open => LinForm::lam(i, 1.0),
+            _ => LinForm::disp(i, r),
+        };
+        let t = match c {
+            Class::Open => LinForm::lam(p + i, 1.0),
+            Class::Stick => LinForm::disp(p + i, r),
+            Class::SlipPlus => LinForm::lam2(p + i, 1.0, i, -f),
+            Class::SlipMinus => LinForm::lam2(p + i, 1.0, i, f),
+        };
+        [nu, t]
+    }
+
+    /// The constant part of the piece equations at fixed α: `M_S λ = rhs` with
+    /// `rhs = −bᵀ (q − g)` row by row (also gives `M_S λ' = −bᵀ q'` when passed `q'`).
+    pub fn piece_rhs(&self, classes: &[Class], qg: &[f64]) -> Vec<f64> {
+        let mut rhs = vec![0.0; 2 * self.p];
+        for (i, &c) in classes.iter().enumerate() {
+            let [nu, t] = self.equations(i, c);
+            rhs[i] = -nu.b.1 * qg[nu.b.0];
+            rhs[self.p + i] = -t.b.1 * qg[t.b.0];
+        }
+        rhs
+    }
+
+    /// The square part `M_S = ∂H/∂λ` of the piece Jacobian.
+    pub fn piece_matrix(&self, w: MatRef<'_, f64>, classes: &[Class]) -> Mat<f64> {
+        let m = 2 * self.p;
+        let zeros = vec![0.0; m];
+        let (j, _) = self.jacobian(w, classes, &zeros, &zeros, 0.0);
+        j.as_ref().subcols(0, m).to_owned()
+    }
+
+    /// All guards of a class vector.
+    pub fn guards(&self, classes: &[Class]) -> Vec<Guard> {
+        classes
+            .iter()
+            .enumerate()
+            .flat_map(|(node, &c)| guard_kinds(c).iter().map(move |&kind| Guard { node, kind }))
+            .collect()
+    }
+
+    /// The piece Jacobian `J_S` (m × (m+1)) at `q'` and the constant so that the piece is
+    /// `J_S (λ, α) = rhs` at the current α (rhs computed from `q(α)` and α).
+    pub fn jacobian(
+        &self,
+        w: MatRef<'_, f64>,
+        classes: &[Class],
+        q_minus_g: &[f64],
+        dq: &[f64],
+        alpha: f64,
+    ) -> (Mat<f64>, Vec<f64>) {
+        let m = 2 * self.p;
+        let mut j = Mat::<f64>::zeros(m, m + 1);
+        let mut rhs = vec![0.0; m];
+        let mut row = vec![0.0; m + 1];
+        for (i, &c) in classes.iter().enumerate() {
+            let eqs = self.equations(i, c);
+            for (k, form) in eqs.iter().enumerate() {
+                let r_idx = if k == 0 { i } else { self.p + i };
+                form.row(w, dq, &mut row);
+                for (col, &v) in row.iter().enumerate() {
+                    j[(r_idx, col)] = v;
+                }
+                // J (λ, α) + bᵀ(q − g) − row_α α = 0
+                let (bj, bc) = form.b;
+                rhs[r_idx] = -(bc * q_minus_g[bj]) + row[m] * alpha;
+            }
+        }
+        (j, rhs)
+    }
+}
+
+/// `d = q − (g, 0) + W λ`.
+pub(crate) fn displacement_gaps(w: MatRef<'_, f64>, q_minus_g: &[f64], lam: &[f64]) -> Vec<f64> {
+    let m = q_minus_g.len();
+    let mut d = q_minus_g.to_vec();
+    for (k, &l) in lam.iter().enumerate() {
+        if l != 0.0 {
+            for (i, di) in d.iter_mut().enumerate().take(m) {
+                *di += w[(i, k)] * l;
+            }
+        }
+    }
+    d
+}
+
+/// `q(α) − (g, 0)`.
+pub(crate) fn shift_gap(q: &[f64], gap: &[f64]) -> Vec<f64> {
+    let mut v = q.to_vec();
+    for (vi, gi) in v.iter_mut().zip(gap) {
+        *vi -= gi;
+    }
+    v
+}
+
+/// Result of an LU with partial pivoting: solves and the sign of the determinant.
+pub(crate) struct DenseLu {
+    lu: faer::linalg::solvers::PartialPivLu<f64>,
+    /// Sign of the determinant (0 when a pivot is exactly 0).
+    pub det_sign: i8,
+    /// min |U_ii| / max |U_ii|: a cheap singularity indicator.
+    pub pivot_ratio: f64,
+}
+
+impl DenseLu {
+    pub fn new(a: MatRef<'_, f64>) -> Self {
+        let lu = a.partial_piv_lu();
+        let u = lu.U();
+        let n = u.nrows();
+        let mut sign: i8 = perm_parity(lu.P().arrays().0);
+        let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+        for i in 0..n {
+            let v = u[(i, i)];
+            if v < 0.0 {
+                sign = -sign;
+            } else if v == 0.0 || v.is_nan() {
+                sign = 0;
+            }
+            lo = lo.min(v.abs());
+            hi = hi.max(v.abs());
+        }
+        let pivot_ratio = if n == 0 || hi == 0.0 { 0.0 } else { lo / hi };
+        Self {
+            lu,
+            det_sign: sign,
+            pivot_ratio,
+        }
+    }
+
+    pub fn solve(&self, b: &[f64]) -> Vec<f64> {
+        use faer::linalg::solvers::Solve;
+        let n = b.len();
+        let mut x = b.to_vec();
+        let xm = faer::MatMut::from_column_major_slice_mut(&mut x, n, 1);
+        self.lu.solve_in_place(xm);
+        x
+    }
+}
+
+fn perm_parity(fwd: &[usize]) -> i8 {
+    let n = fwd.len();
+    let mut seen = vec![false; n];
+    let mut sign = 1i8;
+    for s in 0..n {
+        if seen[s] {
+            continue;
+        }
+        let mut len = 0;
+        let mut k = s;
+        while !seen[k] {
+            seen[k] = true;
+            k = fwd[k];
+            len += 1;
+        }
+        if len % 2 == 0 {
+            sign = -sign;
+        }
+    }
+    sign
+}
+
+/// A unit vector spanning `ker J` for `J ∈ R^{m×(m+1)}` of rank m, by LU with full
+/// pivoting (`P J Qᵀ = L U`, back-substitution with the free variable set to 1).
+/// Returns `None` when the rank is below m (the last pivot is below `1e-13` of the first).
+pub(crate) fn kernel_vector(j: MatRef<'_, f64>) -> Option<Vec<f64>> {
+    let m = j.nrows();
+    let lu = j.full_piv_lu();
+    let u = lu.U();
+    let u00 = u[(0, 0)].abs();
+    if m > 0 && !(u[(m - 1, m - 1)].abs() > 1e-13 * u00) {
+        return None;
+    }
+    // U y = 0, y_m = 1
+    let mut y = vec![0.0; m + 1];
+    y[m] = 1.0;
+    for i in (0..m).rev() {
+        let mut s = u[(i, m)];
+        for k in i + 1..m {
+            s += u[(i, k)] * y[k];
+        }
+        y[i] = -s / u[(i, i)];
+    }
+    // x = Qᵀ y
+    let fwd = lu.Q().arrays().0;
+    let mut x = vec![0.0; m + 1];
+    for (i, &f) in fwd.iter().enumerate() {
+        x[f] = y[i];
+    }
+    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    if !(norm.is_finite() && norm > 0.0) {
+        return None;
+    }
+    x.iter_mut().for_each(|v| *v /= norm);
+    Some(x)
+}
+
+/// `sign det [J; tᵀ]` (the orientation of the tangent t, SPEC §4).
+pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
+    let m = j.nrows();
+    let mut b = Mat::<f64>::zeros(m + 1, m + 1);
+    for r in 0..m {
+        for c in 0..=m {
+            b[(r, c)] = j[(r, c)];
+        }
+    }
+    for c in 0..=m {
+        b[(m, c)] = t[c];
+    }
+    DenseLu::new(b.as_ref()).det_sign
+}
+
+/// The relative residual of the seed's H at `(u, λ, α)`:
+///
+/// ```text
+/// H1 = A u − f(α) − Nᵀ λν − Tᵀ λt
+/// H2 = λν − min(λν − r (N u − g), 0)
+/// H3 = λt − P_[−b, b](λt − r T u),   b = max(−F λν, 0)
+/// residual = ‖(H1, H2, H3)‖∞ / max(‖f‖∞, ‖A u‖∞, ‖Bᵀ λ‖∞, ‖λ‖∞, r ‖B u − (g, 0)‖∞, 1e-300)
+/// ```
+///
+/// The scale is the largest force-like term of the equations, so the number is a relative
+/// backward error; it does not depend on the units chosen for `u` or `f`.
+pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
+    let (n, p, r) = (problem.n(), problem.p(), problem.r());
+    let mut au = vec![0.0; n];
+    problem.a().mul_vec(u, &mut au);
+    let mut btl = vec![0.0; n];
+    problem.b().mul_t_vec_add(lam, &mut btl);
+    let mut h = 0.0f64;
+    let mut scale = 1e-300f64;
+    for i in 0..n {
+        h = h.max((au[i] - f[i] - btl[i]).abs());
+        scale = scale.max(f[i].abs()).max(au[i].abs()).max(btl[i].abs());
+    }
+    let mut bu = vec![0.0; 2 * p];
+    problem.b().mul_vec(u, &mut bu);
+    for i in 0..p {
+        bu[i] -= problem.gap()[i];
+    }
+    for i in 0..p {
+        let (ln, lt) = (lam[i], lam[p + i]);
+        let h2 = ln - (ln - r * bu[i]).min(0.0);
+        let b = (-problem.friction()[i] * ln).max(0.0);
+        let h3 = lt - (lt - r * bu[p + i]).clamp(-b, b);
+        h = h.max(h2.abs()).max(h3.abs());
+        scale = scale
+            .max(ln.abs())
+            .max(lt.abs())
+            .max(r * bu[i].abs())
+            .max(r * bu[p + i].abs());
+    }
+    h / scale
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kernel_of_random_wide_matrix_is_annihilated() {
+        let mut s = 12345u64;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s % 2000) as f64 / 1000.0 - 1.0
+        };
+        for m in [1, 2, 5, 9] {
+            let j = Mat::<f64>::from_fn(m, m + 1, |_, _| rnd());
+            let t = kernel_vector(j.as_ref()).unwrap();
+            for r in 0..m {
+                let s: f64 = (0..=m).map(|c| j[(r, c)] * t[c]).sum();
+                assert!(s.abs() < 1e-13, "row {r}: {s}");
+            }
+        }
+    }
+
+    #[test]
+    fn determinant_sign_matches_hand_values() {
+        // det [[0, 1], [1, 0]] = -1 (a swap), det [[2, 1], [1, 3]] = 5, det diag(-1, 2, 3) < 0
+        let a = Mat::<f64>::from_fn(2, 2, |i, j| if i != j { 1.0 } else { 0.0 });
+        assert_eq!(DenseLu::new(a.as_ref()).det_sign, -1);
+        let b = Mat::<f64>::from_fn(2, 2, |i, j| [[2.0, 1.0], [1.0, 3.0]][i][j]);
+        assert_eq!(DenseLu::new(b.as_ref()).det_sign, 1);
+        let c = Mat::<f64>::from_fn(3, 3, |i, j| if i == j { [-1.0, 2.0, 3.0][i] } else { 0.0 });
+        assert_eq!(DenseLu::new(c.as_ref()).det_sign, -1);
+        // a 3-cycle permutation matrix has det +1
+        let d = Mat::<f64>::from_fn(3, 3, |i, j| if j == (i + 1) % 3 { 1.0 } else { 0.0 });
+        assert_eq!(DenseLu::new(d.as_ref()).det_sign, 1);
+    }
+}
