@@ -75,15 +75,10 @@ pub struct FoldVariant {
 }
 
 impl Default for FoldVariant {
-    /// See `docs/case-study.md` for the choice of friction and load.
+    /// [`RectSpec::high_friction`], α of the solutions figure chosen automatically.
     fn default() -> Self {
-        let spec = RectSpec {
-            friction: 1.0,
-            load_name: "press-shear, high friction".into(),
-            ..RectSpec::default()
-        };
         Self {
-            spec,
+            spec: RectSpec::high_friction(),
             alpha_query: None,
         }
     }
@@ -325,21 +320,20 @@ fn draw_class_markers<'a, 'b: 'a>(
     Ok(())
 }
 
-/// Tick label: no "-0", at most 4 significant digits, scientific for tiny or huge values.
+/// Tick label for an axis spanning `span`: one format per axis (decimals when the span
+/// is between 0.01 and 1e5, scientific otherwise), no "-0".
 fn tick(v: f64, span: f64) -> String {
-    let a = v.abs();
-    if a <= 1e-9 * span {
+    if v.abs() <= 1e-9 * span {
         return "0".into();
     }
-    if (1e-3..1e5).contains(&a) {
-        let digits = (3 - a.log10().floor() as i32).clamp(0, 6) as usize;
+    if (0.01..1e5).contains(&span) {
+        let digits = (2 - span.log10().floor() as i32).clamp(0, 8) as usize;
         let t = format!("{v:.digits$}");
-        let t = if t.contains('.') {
+        if t.contains('.') {
             t.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
             t
-        };
-        if t == "-0" { "0".into() } else { t }
+        }
     } else {
         format!("{v:.1e}")
     }
@@ -785,6 +779,8 @@ pub struct MarkedPoint {
     pub lambda_t: Vec<f64>,
     /// α turns back here.
     pub fold: bool,
+    /// 0-based node that changes class (one point per event).
+    pub node: usize,
 }
 
 /// The path figure: top, the total contact forces `Σλν`, `Σλt` against α; bottom, `λν`
@@ -875,7 +871,7 @@ pub fn plot_path(
                         },
                     )
                 },
-                k == 0,
+                (k == 0).then_some(ar.end - ar.start),
             )?;
         }
         chart
@@ -932,7 +928,8 @@ pub fn plot_path(
                     first = false;
                 }
             }
-            draw_points(&mut chart, points, |m| (m.alpha, m.lambda_n[i]), false)?;
+            let own: Vec<MarkedPoint> = points.iter().filter(|m| m.node == i).cloned().collect();
+            draw_points(&mut chart, &own, |m| (m.alpha, m.lambda_n[i]), None)?;
         }
         chart
             .configure_series_labels()
@@ -953,7 +950,7 @@ fn draw_points<'a, 'b: 'a>(
     chart: &mut Chart<'a, 'b>,
     points: &[MarkedPoint],
     at: impl Fn(&MarkedPoint) -> (f64, f64),
-    numbers: bool,
+    numbers: Option<f64>,
 ) -> std::result::Result<(), String> {
     chart
         .draw_series(
@@ -972,7 +969,7 @@ fn draw_points<'a, 'b: 'a>(
                 .map(|m| TriangleMarker::new(at(m), 7, red.filled())),
         )
         .map_err(|e| e.to_string())?;
-    if numbers {
+    if let Some(alpha_span) = numbers {
         a.label("fold (α turns back)")
             .legend(move |(x, y)| TriangleMarker::new((x, y), 7, red.filled()));
         chart
@@ -984,18 +981,33 @@ fn draw_points<'a, 'b: 'a>(
                     .map(|m| Circle::new(at(m), 3, BLACK.filled())),
             )
             .map_err(|e| e.to_string())?
-            .label("transition point")
+            .label("transition point k")
             .legend(|(x, y)| Circle::new((x, y), 3, BLACK.filled()));
-        let mut last_label: Option<(f64, usize)> = None;
-        for m in points {
-            if last_label.is_some_and(|(a, t)| t == m.transition && a == m.alpha) {
-                continue;
+        // one label per cluster of transition points closer than 2% of the α range
+        let mut clusters: Vec<(usize, Vec<usize>)> = Vec::new();
+        for (k, m) in points.iter().enumerate() {
+            match clusters.last_mut() {
+                Some((first, ts)) if (points[*first].alpha - m.alpha).abs() < 0.02 * alpha_span => {
+                    if !ts.contains(&m.transition) {
+                        ts.push(m.transition);
+                    }
+                }
+                _ => clusters.push((k, vec![m.transition])),
             }
-            last_label = Some((m.alpha, m.transition));
-            let (x, y) = at(m);
+        }
+        for (first, ts) in clusters {
+            let text = if ts.len() > 3 {
+                format!("{}–{}", ts[0], ts[ts.len() - 1])
+            } else {
+                ts.iter()
+                    .map(|t| t.to_string())
+                    .collect::<Vec<_>>()
+                    .join(",")
+            };
             chart
-                .draw_series([EmptyElement::at((x, y))
-                    + Text::new(format!("{}", m.transition), (3, -16), (FONT, 12))])
+                .draw_series([
+                    EmptyElement::at(at(&points[first])) + Text::new(text, (3, -16), (FONT, 12))
+                ])
                 .map_err(|e| e.to_string())?;
         }
     }
@@ -1010,13 +1022,13 @@ pub fn plot_solutions(
     title: &str,
     file: &FsPath,
 ) -> Result<()> {
-    let root = SVGBackend::new(file, (1200, 1060)).into_drawing_area();
+    let root = SVGBackend::new(file, (1200, 1300)).into_drawing_area();
     let draw = || -> std::result::Result<(), String> {
         root.fill(&WHITE).map_err(|e| e.to_string())?;
         let root = root.titled(title, (FONT, 22)).map_err(|e| e.to_string())?;
         let h = root.dim_in_pixel().1;
         let (panels, strips) = root.split_vertically(h - 80);
-        let (top, bottom) = panels.split_vertically((h - 80) / 2);
+        let areas = panels.split_evenly((3, 1));
         let (strip1, strip2) = strips.split_vertically(40);
         let ser = |f: fn(&ContactData) -> &[f64]| -> Vec<(&[f64], &[Class], RGBColor)> {
             list.iter()
@@ -1025,16 +1037,22 @@ pub fn plot_solutions(
                 .collect()
         };
         node_panel(
-            &top,
+            &areas[0],
             "normal contact force λν",
             "λν  [E·L]",
             &ser(|d| &d.lambda_n),
         )?;
         node_panel(
-            &bottom,
+            &areas[1],
             "tangential contact force λt",
             "λt  [E·L]",
             &ser(|d| &d.lambda_t),
+        )?;
+        node_panel(
+            &areas[2],
+            "normal displacement uν = −u_y (< 0: lifted off)",
+            "uν  [L]",
+            &ser(|d| &d.u_n),
         )?;
         let lines: Vec<Entry> = (0..list.len())
             .map(|k| {
@@ -1146,6 +1164,7 @@ fn marked_points(path: &Path) -> Vec<MarkedPoint> {
             lambda_n: e.state.lambda_n.clone(),
             lambda_t: e.state.lambda_t.clone(),
             fold: e.fold,
+            node: e.node,
         })
         .collect()
 }
@@ -1154,15 +1173,25 @@ fn marked_points(path: &Path) -> Vec<MarkedPoint> {
 /// over the path.
 fn event_nodes(path: &Path) -> Vec<usize> {
     let mut v: Vec<usize> = Vec::new();
-    for e in path.events() {
-        if !v.contains(&e.node) {
+    for e in path.events().iter().filter(|e| e.fold) {
+        if !v.contains(&e.node) && v.len() < 4 {
             v.push(e.node);
         }
     }
-    if v.len() > 8 {
-        let step = v.len() as f64 / 8.0;
-        v = (0..8).map(|k| v[(k as f64 * step) as usize]).collect();
+    let mut rest: Vec<usize> = Vec::new();
+    for e in path.events() {
+        if !v.contains(&e.node) && !rest.contains(&e.node) {
+            rest.push(e.node);
+        }
     }
+    let room = 8 - v.len();
+    if rest.len() > room {
+        let step = rest.len() as f64 / room as f64;
+        rest = (0..room)
+            .map(|k| rest[(k as f64 * step) as usize])
+            .collect();
+    }
+    v.extend(rest);
     v.sort_unstable();
     v
 }
@@ -1448,20 +1477,34 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
     })
 }
 
-/// α inside the first fold region: the middle between the first fold and the nearer of
-/// its neighbouring transition points (the path covers that interval at least twice).
+/// An α inside a fold region where the traced path has the most solutions: the middle
+/// of the widest gap between consecutive distinct transition α's among the gaps covered
+/// by the largest number of traced (non-vertical) pieces. `None` when no α has two.
 fn fold_query(path: &Path) -> Option<f64> {
-    let ev = path.events();
-    let k = ev.iter().position(|e| e.fold)?;
-    let a = ev[k].alpha;
-    let prev = ev[..k].iter().rev().find(|e| e.alpha != a).map(|e| e.alpha);
-    let next = ev[k + 1..].iter().find(|e| e.alpha != a).map(|e| e.alpha);
-    let piece_ends = path.pieces().last().map(|r| r.alpha_to);
-    let cands: Vec<f64> = [prev, next.or(piece_ends)].into_iter().flatten().collect();
-    let b = cands
-        .into_iter()
-        .min_by(|x, y| (x - a).abs().total_cmp(&(y - a).abs()))?;
-    Some(0.5 * (a + b))
+    let mut alphas: Vec<f64> = path.events().iter().map(|e| e.alpha).collect();
+    for r in path.pieces() {
+        alphas.push(r.alpha_from);
+        alphas.push(r.alpha_to);
+    }
+    alphas.sort_by(f64::total_cmp);
+    alphas.dedup();
+    let mut best: Option<(usize, f64, f64)> = None;
+    for w in alphas.windows(2) {
+        let (a, width) = (0.5 * (w[0] + w[1]), w[1] - w[0]);
+        let count = path
+            .pieces()
+            .iter()
+            .filter(|r| r.alpha_from.min(r.alpha_to) < a && a < r.alpha_from.max(r.alpha_to))
+            .count();
+        let better = match best {
+            None => true,
+            Some((c, wd, _)) => count > c || (count == c && width > wd),
+        };
+        if better {
+            best = Some((count, width, a));
+        }
+    }
+    best.filter(|b| b.0 >= 2).map(|b| b.2)
 }
 
 fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> Result<FoldReport> {
@@ -1514,13 +1557,13 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
             .map(|(k, s)| {
                 let d = tr.path.pieces()[s.piece].direction;
                 format!(
-                    "solution {} (piece {}, α {} along the path)",
+                    "{}: piece {}, α {}",
                     k + 1,
                     s.piece + 1,
                     match d {
-                        1 => "increasing",
-                        -1 => "decreasing",
-                        _ => "constant",
+                        1 => "↑",
+                        -1 => "↓",
+                        _ => "const",
                     }
                 )
             })
@@ -1658,6 +1701,7 @@ mod tests {
                 lambda_n: pieces[k].lambda_n_from.clone(),
                 lambda_t: pieces[k].lambda_t_from.clone(),
                 fold: k == 1,
+                node: k,
             })
             .collect();
         plot_path(&pieces, &pts, &[0, 5, 12], "path", &dir.join("path.svg")).unwrap();

@@ -164,12 +164,19 @@ pub struct RectSpec {
 }
 
 impl Default for RectSpec {
-    /// The case study: 31 × 22 nodes on `(0, 3) × (0, 2.1)` (square elements of side 0.1),
-    /// `E = 1`, `ν = 0.3`, `F = 0.3`, no gap, α ∈ [−0.5, 1.5];
-    /// `f0`: a downward pressure on the top growing linearly from 0.004 at the clamped
-    /// end to 0.024 at the free end; `f1`: a uniform shear 0.01 to the right on the top
-    /// and an upward shear on the right side decreasing linearly from 0.012 at the bottom
-    /// to 0 at the top. See `docs/case-study.md` for why.
+    /// The case study (the project's reconstruction, see `docs/case-study.md`): 31 × 22
+    /// nodes on `(0, 3) × (0, 2.1)` (square elements of side 0.1), `E = 1`, `ν = 0.3`,
+    /// `F = 0.3`, no gap, α ∈ [−0.5, 1.5], consistent nodal forces, and the load
+    /// "lift-press":
+    /// * `f0`: an upward traction 0.01 on the right side (lifting the free end), and on
+    ///   the top a uniform shear 0.01 towards the clamp (−x) with a downward pressure
+    ///   growing linearly from 0.0112 at the clamped end to 0.0208 at the free end;
+    /// * `f1`: a further pressure on the top with the same profile shape, from 0.00161 to
+    ///   0.00299 (0.0023 × (0.7 → 1.3)).
+    ///
+    /// On [−0.5, 1.5] the contact zone grows from nodes 1–9 towards the free end; the path
+    /// has 14 transition points (no contact → slip, slip → stick, stick → slip), and
+    /// transition points 6, 7, 8 have the nodes and kinds the paper reports.
     fn default() -> Self {
         Self {
             nx: 31,
@@ -181,15 +188,67 @@ impl Default for RectSpec {
             thickness: 1.0,
             friction: 0.3,
             gap: 0.0,
+            load0: vec![
+                Traction::uniform(Side::Right, [0.0, 0.01]),
+                Traction::linear(Side::Top, [-0.01, -0.0112], [-0.01, -0.0208]),
+            ],
+            load1: vec![Traction::linear(
+                Side::Top,
+                [0.0, -0.00161],
+                [0.0, -0.00299],
+            )],
+            rule: ForceRule::Consistent,
+            alpha_start: -0.5,
+            alpha_end: 1.5,
+            load_name: "lift-press".into(),
+        }
+    }
+}
+
+impl RectSpec {
+    /// The load of the sample case `press-shear` shipped with the project's brief, on the
+    /// case-study mesh: `f0` a downward pressure on the top growing linearly from 0.004
+    /// at the clamped end to 0.024 at the free end; `f1` a uniform shear 0.01 (+x) on the
+    /// top and an upward traction on the right side decreasing linearly from 0.012 at the
+    /// bottom to 0 at the top. With [`ForceRule::Trapezoid`] this reproduces the sample's
+    /// files exactly.
+    pub fn press_shear() -> Self {
+        Self {
             load0: vec![Traction::linear(Side::Top, [0.0, -0.004], [0.0, -0.024])],
             load1: vec![
                 Traction::uniform(Side::Top, [0.01, 0.0]),
                 Traction::linear(Side::Right, [0.0, 0.012], [0.0, 0.0]),
             ],
-            rule: ForceRule::Consistent,
-            alpha_start: -0.5,
-            alpha_end: 1.5,
             load_name: "press-shear".into(),
+            ..Self::default()
+        }
+    }
+
+    /// The high-friction variant of the case study (see `docs/case-study.md`): the same
+    /// mesh and material with `F = 3` and the load "pull-shear", α ∈ [−0.5, 2.5]:
+    /// * `f0`: on the top a uniform pressure 0.004 and shear 0.004 (+x); on the right side
+    ///   a uniform outward pull 0.008 (+x) and upward shear 0.002;
+    /// * `f1`: on the top a shear 0.0025 (+x); on the right side a pull 0.003 and upward
+    ///   shear 0.002.
+    ///
+    /// The body is peeled off the foundation from the clamped side until only the free
+    /// corner (node 30) touches and sticks; when it starts to slip, α turns back (a
+    /// non-smooth fold; a single slipping corner node makes its piece singular at
+    /// `F = W_νν/|W_νt| ≈ 2.32` on this mesh).
+    pub fn high_friction() -> Self {
+        Self {
+            friction: 3.0,
+            alpha_end: 2.5,
+            load0: vec![
+                Traction::uniform(Side::Top, [0.004, -0.004]),
+                Traction::uniform(Side::Right, [0.008, 0.002]),
+            ],
+            load1: vec![
+                Traction::uniform(Side::Top, [0.0025, 0.0]),
+                Traction::uniform(Side::Right, [0.003, 0.002]),
+            ],
+            load_name: "pull-shear".into(),
+            ..Self::default()
         }
     }
 }

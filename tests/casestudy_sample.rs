@@ -53,7 +53,7 @@ fn generator_reproduces_the_sample_case() {
     };
     let spec = RectSpec {
         rule: ForceRule::Trapezoid,
-        ..RectSpec::default()
+        ..RectSpec::press_shear()
     };
     let c = generate(&spec).unwrap();
     for (name, m) in [("A", &c.a), ("N", &c.n_mat), ("T", &c.t_mat)] {
