@@ -812,7 +812,7 @@ mod tests {
         let fy: f64 = f.iter().skip(1).step_by(2).sum();
         let hx = spec.h().0;
         let t1 = -1.0 - 2.0 / (spec.nx - 1) as f64;
-        let corner = hx * (2.0 * -1.0 + t1) / 6.0;
+        let corner = hx * (-2.0 + t1) / 6.0;
         assert!((fy - (spec.lx * -2.0 - corner)).abs() < 1e-14);
     }
 
