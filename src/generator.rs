@@ -111,6 +111,61 @@ impl Traction {
     }
 }
 
+impl std::str::FromStr for Side {
+    type Err = Error;
+    /// `"bottom"`, `"right"`, `"top"`, `"left"` (case-insensitive).
+    fn from_str(s: &str) -> Result<Side> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "bottom" => Ok(Side::Bottom),
+            "right" => Ok(Side::Right),
+            "top" => Ok(Side::Top),
+            "left" => Ok(Side::Left),
+            _ => Err(Error::InvalidParameter(format!(
+                "side \"{s}\": expected bottom, right, top or left"
+            ))),
+        }
+    }
+}
+
+impl std::str::FromStr for Traction {
+    type Err = Error;
+    /// Parses `SIDE:TX,TY` (uniform) or `SIDE:TX,TY:TX2,TY2` (linear from the first end
+    /// of the side to the second), e.g. `top:0,-0.004:0,-0.024` or `right:0,0.01`
+    /// (the command-line form of `fricont gen-rect`). Errors:
+    /// [`Error::InvalidParameter`] saying what is wrong.
+    fn from_str(s: &str) -> Result<Traction> {
+        let bad = |m: &str| {
+            Error::InvalidParameter(format!(
+                "traction \"{s}\": {m} (expected SIDE:TX,TY or SIDE:TX,TY:TX2,TY2)"
+            ))
+        };
+        let parts: Vec<&str> = s.split(':').collect();
+        if !(2..=3).contains(&parts.len()) {
+            return Err(bad("wrong number of ':'-separated fields"));
+        }
+        let side: Side = parts[0].parse()?;
+        let pair = |t: &str| -> Result<[f64; 2]> {
+            let v: Vec<&str> = t.split(',').collect();
+            if v.len() != 2 {
+                return Err(bad("a value must be two numbers TX,TY"));
+            }
+            let x: f64 = v[0].trim().parse().map_err(|_| bad("not a number"))?;
+            let y: f64 = v[1].trim().parse().map_err(|_| bad("not a number"))?;
+            if !x.is_finite() || !y.is_finite() {
+                return Err(bad("non-finite value"));
+            }
+            Ok([x, y])
+        };
+        let start = pair(parts[1])?;
+        let end = if parts.len() == 3 {
+            pair(parts[2])?
+        } else {
+            start
+        };
+        Ok(Traction { side, start, end })
+    }
+}
+
 /// How surface tractions become nodal forces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -830,6 +885,24 @@ mod tests {
         assert!(c.gap.is_none());
         assert_eq!(c.meta["n"], 1320);
         assert_eq!(c.meta["p"], 30);
+    }
+
+    #[test]
+    fn tractions_parse_from_the_command_line_form() {
+        let t: Traction = "top:0,-0.004:0,-0.024".parse().unwrap();
+        assert_eq!(t, Traction::linear(Side::Top, [0.0, -0.004], [0.0, -0.024]));
+        let t: Traction = "Right:0,0.01".parse().unwrap();
+        assert_eq!(t, Traction::uniform(Side::Right, [0.0, 0.01]));
+        for bad in [
+            "top",
+            "top:1",
+            "middle:0,1",
+            "top:0,x",
+            "top:0,1:2,3:4,5",
+            "top:inf,0",
+        ] {
+            assert!(bad.parse::<Traction>().is_err(), "{bad}");
+        }
     }
 
     #[test]
