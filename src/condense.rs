@@ -20,6 +20,10 @@ use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 use crate::error::{Error, Result};
 use crate::problem::CsrMatrix;
 
+/// `A⁻¹ Bᵀ` is kept (and u at any point costs one n×2p product instead of a back-solve)
+/// when it has at most this many entries (128 MiB).
+const Z_BUDGET: usize = 1 << 24;
+
 /// Columns of `Bᵀ` solved at once when forming `W` (bounds the dense workspace to
 /// `n × BLOCK` numbers).
 const BLOCK: usize = 32;
@@ -32,6 +36,8 @@ pub struct Delassus {
     l_values: Vec<f64>,
     b: CsrMatrix,
     w: Mat<f64>,
+    /// `A⁻¹ Bᵀ` (n × 2p) when it fits [`Z_BUDGET`].
+    z: Option<Mat<f64>>,
 }
 
 impl Delassus {
@@ -85,15 +91,19 @@ impl Delassus {
             l_values,
             b: b.clone(),
             w: Mat::zeros(0, 0),
+            z: None,
         };
-        this.w = this.form_w()?;
+        let (w, z) = this.form_w()?;
+        this.w = w;
+        this.z = z;
         this.check_w()?;
         Ok(this)
     }
 
-    fn form_w(&self) -> Result<Mat<f64>> {
+    fn form_w(&self) -> Result<(Mat<f64>, Option<Mat<f64>>)> {
         let m = self.b.nrows();
         let mut w = Mat::<f64>::zeros(m, m);
+        let mut z = (self.n * m <= Z_BUDGET).then(|| Mat::<f64>::zeros(self.n, m));
         let mut x = Mat::<f64>::zeros(self.n, BLOCK.min(m));
         let mut col0 = 0;
         while col0 < m {
@@ -111,6 +121,9 @@ impl Delassus {
                     w[(i, col0 + c)] = self.b.row(i).map(|(j, v)| v * xb[(j, c)]).sum();
                 }
             }
+            if let Some(z) = z.as_mut() {
+                z.as_mut().subcols_mut(col0, k).copy_from(xb.as_ref());
+            }
             col0 += k;
         }
         // symmetrise the rounding
@@ -121,7 +134,7 @@ impl Delassus {
                 w[(j, i)] = s;
             }
         }
-        Ok(w)
+        Ok((w, z))
     }
 
     fn check_w(&self) -> Result<()> {
@@ -223,5 +236,30 @@ impl Delassus {
         self.b.mul_t_vec_add(lambda, &mut x);
         self.solve_in_place(&mut x);
         x
+    }
+
+    /// `u += A⁻¹ Bᵀ λ`: one dense n×2p product when `A⁻¹ Bᵀ` is kept (n·2p ≤ 2^24),
+    /// one back-solve otherwise.
+    pub fn add_compliance(&self, lambda: &[f64], u: &mut [f64]) {
+        match &self.z {
+            Some(z) => {
+                for (k, &l) in lambda.iter().enumerate() {
+                    if l != 0.0 {
+                        let col = z.col(k);
+                        for (i, ui) in u.iter_mut().enumerate() {
+                            *ui += col[i] * l;
+                        }
+                    }
+                }
+            }
+            None => {
+                let mut x = vec![0.0; u.len()];
+                self.b.mul_t_vec_add(lambda, &mut x);
+                self.solve_in_place(&mut x);
+                for (ui, xi) in u.iter_mut().zip(x) {
+                    *ui += xi;
+                }
+            }
+        }
     }
 }

@@ -269,7 +269,13 @@ fn parse_meta(path: &FsPath, text: &str) -> Result<Meta> {
     };
     let positive_int = |key: &str| -> Result<usize> {
         let v = get(key)?;
-        match v.as_u64() {
+        // Integers, and floats with an integral value (1320.0, as some writers emit).
+        let as_int = v.as_u64().or_else(|| {
+            v.as_f64()
+                .filter(|x| x.fract() == 0.0 && *x > 0.0 && *x < 9.007_199_254_740_992e15)
+                .map(|x| x as u64)
+        });
+        match as_int {
             Some(x) if x > 0 => usize::try_from(x)
                 .map_err(|_| io_err(path, None, format!("\"{key}\" = {x} is too large"))),
             _ => Err(io_err(
@@ -471,8 +477,15 @@ fn parse_mtx(
             format!("a symmetric matrix must be square, this one is {nrows}x{ncols}"),
         ));
     }
-    let cap = if symmetric { 2 * nnz } else { nnz };
-    let mut triplets: Vec<(usize, usize, f64)> = Vec::with_capacity(cap.min(1 << 28));
+    // Reserve for the announced entries, but never more than the file can hold (an entry
+    // line has at least 6 bytes): a corrupt size line must not trigger a huge allocation.
+    let max_entries = nnz.min(text.len() / 6 + 1);
+    let cap = if symmetric {
+        2 * max_entries
+    } else {
+        max_entries
+    };
+    let mut triplets: Vec<(usize, usize, f64)> = Vec::with_capacity(cap);
     // For symmetric files: which triangle the off-diagonal entries are in, and where seen.
     let mut triangle: Option<(bool, usize)> = None;
     let mut count = 0usize;
@@ -491,16 +504,20 @@ fn parse_mtx(
                 format!("more entries than the {nnz} announced on line {size_ln}"),
             ));
         }
-        let toks: Vec<&str> = t.split_whitespace().collect();
-        if toks.len() != 3 {
+        let mut it = t.split_ascii_whitespace();
+        let (Some(ti), Some(tj), Some(tv), None) = (it.next(), it.next(), it.next(), it.next())
+        else {
             return Err(io_err(
                 path,
                 Some(ln),
-                format!("expected \"row col value\", found {} fields", toks.len()),
+                format!(
+                    "expected \"row col value\", found {} fields",
+                    t.split_ascii_whitespace().count()
+                ),
             ));
-        }
-        let i = parse_count(path, ln, toks[0], "row index")?;
-        let j = parse_count(path, ln, toks[1], "column index")?;
+        };
+        let i = parse_count(path, ln, ti, "row index")?;
+        let j = parse_count(path, ln, tj, "column index")?;
         if i == 0 || i > nrows {
             return Err(io_err(
                 path,
@@ -515,7 +532,7 @@ fn parse_mtx(
                 format!("column index {j} out of range 1..={ncols} (indices are 1-based)"),
             ));
         }
-        let v = parse_real(path, ln, toks[2], "value")?;
+        let v = parse_real(path, ln, tv, "value")?;
         triplets.push((i - 1, j - 1, v));
         if symmetric && i != j {
             let lower = i > j;
@@ -544,6 +561,18 @@ fn parse_mtx(
             format!("only {count} entries, {nnz} announced on line {size_ln}"),
         ));
     }
+    if nrows > count {
+        // Some row is empty: no stiffness or contact matrix may have one (A would be
+        // singular, B = [N; T] rank-deficient). Checked here so that a corrupt size line
+        // cannot make the CSR conversion allocate for rows that do not exist.
+        return Err(io_err(
+            path,
+            Some(size_ln),
+            format!(
+                "{nrows} rows but only {count} entries: some row is empty (A would be singular, B = [N; T] rank-deficient)"
+            ),
+        ));
+    }
     let name = path.file_name().map_or_else(
         || path.display().to_string(),
         |s| s.to_string_lossy().into_owned(),
@@ -558,7 +587,8 @@ fn read_vector(path: &FsPath, expect: usize, expect_name: &str) -> Result<Vec<f6
 }
 
 fn parse_vector(path: &FsPath, text: &str, expect: usize, expect_name: &str) -> Result<Vec<f64>> {
-    let mut v = Vec::with_capacity(expect);
+    // A number takes at least 2 bytes with its newline: never reserve more than that.
+    let mut v = Vec::with_capacity(expect.min(text.len() / 2 + 1));
     for (i, l) in text.lines().enumerate() {
         let ln = i + 1;
         let t = l.trim();
@@ -738,7 +768,8 @@ mod tests {
             gap: Some(vec![1e-3, 0.0]),
             friction: vec![0.3, 2.9999999999999996],
             alpha_start: 0.1 + 0.2,
-            alpha_end: -1.5,
+            // Read back one ulp off by serde_json without `float_roundtrip`.
+            alpha_end: -f64::from_bits(4595965843552456931),
             meta: serde_json::Value::Object(meta),
         };
         c.write_dir(&t.0).unwrap();
@@ -950,6 +981,11 @@ mod tests {
         assert!(m.contains("\"n\" must be a positive integer"), "{m}");
         let m = broken(
             "meta.json",
+            r#"{"n": 3, "p": 0, "F": 0.5, "alpha_start": -1, "alpha_end": 1}"#,
+        );
+        assert!(m.contains("\"p\" must be a positive integer"), "{m}");
+        let m = broken(
+            "meta.json",
             r#"{"n": 3, "p": 1, "F": [0.5, 1], "alpha_start": -1, "alpha_end": 1}"#,
         );
         assert!(m.contains("\"F\" has 2 values"), "{m}");
@@ -967,6 +1003,53 @@ mod tests {
         assert!(m.contains(":2:") && m.contains("invalid JSON"), "{m}");
         let m = broken("meta.json", "[1, 2]");
         assert!(m.contains("object"), "{m}");
+    }
+
+    #[test]
+    fn corrupt_sizes_fail_cleanly_without_huge_allocations() {
+        // Announced entries far beyond the file.
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix coordinate real general\n1 3 1000000000000000\n1 2 1\n",
+        );
+        assert!(m.contains("only 1 entries"), "{m}");
+        // Absurd dimensions that meta.json agrees with.
+        let t = TempDir::new("huge");
+        write_case(&t.0);
+        std::fs::write(
+            t.0.join("meta.json"),
+            r#"{"n": 1000000000000, "p": 1, "F": 0.5, "alpha_start": 0, "alpha_end": 1}"#,
+        )
+        .unwrap();
+        std::fs::write(
+            t.0.join("A.mtx"),
+            "%%MatrixMarket matrix coordinate real general\n1000000000000 1000000000000 1\n1 1 1\n",
+        )
+        .unwrap();
+        let m = CaseData::read_dir(&t.0).unwrap_err().to_string();
+        assert!(
+            m.contains("A.mtx:2:") && m.contains("some row is empty"),
+            "{m}"
+        );
+        // An empty row in N.
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix coordinate real general\n1 3 0\n",
+        );
+        assert!(m.contains("some row is empty"), "{m}");
+    }
+
+    #[test]
+    fn integral_floats_accepted_for_n_and_p() {
+        let t = TempDir::new("float");
+        write_case(&t.0);
+        std::fs::write(
+            t.0.join("meta.json"),
+            r#"{"n": 3.0, "p": 1.0, "F": 0.5, "alpha_start": 0, "alpha_end": 1}"#,
+        )
+        .unwrap();
+        let c = CaseData::read_dir(&t.0).unwrap();
+        assert_eq!((c.n(), c.p()), (3, 1));
     }
 
     #[test]

@@ -22,21 +22,28 @@
 //! API; reports (CLI, JSON) count nodes from 1 as the paper does.
 //!
 //! ## Example
+//!
+//! One contact node with two dofs: `A = diag(2, 1)`, normal dof 1, tangential dof 2.
+//! The load `f = (1, α)` presses the node with `λν = −1` and shears it; it sticks while
+//! `|λt| = |α| ≤ F |λν| = 0.5` and slips in +t beyond: one transition at α = 0.5.
 //! ```
 //! use std::sync::Arc;
-//! use fricont::{problem::{CsrMatrix, ProblemBuilder, Storage}, load::Load, path::{Path, PathOptions}};
-//! // one dof pressed onto a foundation: A = [1], N = [1; 0]-like 2-dof toy
+//! use fricont::{Class, CsrMatrix, Load, Path, PathOptions, ProblemBuilder, Storage};
 //! let a = CsrMatrix::from_dense(2, 2, &[2.0, 0.0, 0.0, 1.0]).unwrap();
 //! let n = CsrMatrix::from_dense(1, 2, &[1.0, 0.0]).unwrap();
 //! let t = CsrMatrix::from_dense(1, 2, &[0.0, 1.0]).unwrap();
-//! let problem = Arc::new(ProblemBuilder::new(a, Storage::Full, n, t).friction_uniform(0.5).build().unwrap());
-//! let load = Load::affine(vec![-1.0, 0.0], vec![0.0, 1.0]).unwrap();
-//! let mut path = Path::new(problem, load, PathOptions::window(0.0, 2.0)).unwrap();
+//! let problem = ProblemBuilder::new(a, Storage::Full, n, t).friction_uniform(0.5).build().unwrap();
+//! let load = Load::affine(vec![1.0, 0.0], vec![0.0, 1.0]).unwrap();
+//! let mut path = Path::new(Arc::new(problem), load, PathOptions::window(0.0, 2.0)).unwrap();
 //! path.start(0.0, None).unwrap();
-//! let end = path.run().unwrap();
-//! assert!(path.events().len() >= 1);
-//! # let _ = end;
+//! path.run().unwrap();
+//! let e = &path.events()[0];
+//! assert_eq!((e.node, e.from, e.to), (0, Class::Stick, Class::SlipPlus));
+//! assert!((e.alpha - 0.5).abs() < 1e-14);
 //! ```
+
+// Dense linear algebra on small index ranges reads best with explicit indices.
+#![allow(clippy::needless_range_loop)]
 
 pub mod casestudy;
 pub mod class;
@@ -48,6 +55,7 @@ pub mod load;
 pub mod path;
 pub mod piece;
 pub mod problem;
+pub mod report;
 pub mod solve;
 
 pub use class::Class;

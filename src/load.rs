@@ -141,6 +141,8 @@ pub(crate) struct BoundLoad {
     load: Load,
     /// Affine: `[q0, q1]`; basis: `q_j`; general: empty.
     q_basis: Vec<Vec<f64>>,
+    /// The same for `A⁻¹ f_j` (displacements under the load alone).
+    u_basis: Vec<Vec<f64>>,
     weights: Vec<f64>,
     dweights: Vec<f64>,
 }
@@ -154,17 +156,30 @@ impl BoundLoad {
                 del.n()
             )));
         }
-        let (q_basis, k) = match &load {
-            Load::Affine { f0, f1 } => (vec![del.condense(f0), del.condense(f1)], 0),
-            Load::Basis { vectors, .. } => (
-                vectors.iter().map(|v| del.condense(v)).collect(),
-                vectors.len(),
-            ),
-            Load::General { .. } => (Vec::new(), 0),
+        let vectors: Vec<&Vec<f64>> = match &load {
+            Load::Affine { f0, f1 } => vec![f0, f1],
+            Load::Basis { vectors, .. } => vectors.iter().collect(),
+            Load::General { .. } => Vec::new(),
         };
+        let k = if matches!(load, Load::Basis { .. }) {
+            vectors.len()
+        } else {
+            0
+        };
+        let mut u_basis = Vec::with_capacity(vectors.len());
+        let mut q_basis = Vec::with_capacity(vectors.len());
+        for v in vectors {
+            let mut x = v.clone();
+            del.solve_in_place(&mut x);
+            let mut q = vec![0.0; del.b().nrows()];
+            del.b().mul_vec(&x, &mut q);
+            q_basis.push(q);
+            u_basis.push(x);
+        }
         Ok(Self {
             load,
             q_basis,
+            u_basis,
             weights: vec![0.0; k],
             dweights: vec![0.0; k],
         })
@@ -226,6 +241,29 @@ impl BoundLoad {
                 Ok(out)
             }
         }
+    }
+
+    /// `A⁻¹ f(α)` (n entries): free of solves for affine and basis loads.
+    pub(crate) fn displacement(&mut self, alpha: f64, del: &Delassus) -> Result<Vec<f64>> {
+        let weights: Vec<f64> = match &self.load {
+            Load::Affine { .. } => vec![1.0, alpha],
+            Load::Basis { .. } => {
+                self.eval_weights(alpha)?;
+                self.weights.clone()
+            }
+            Load::General { .. } => {
+                let mut f = self.force(alpha)?;
+                del.solve_in_place(&mut f);
+                return Ok(f);
+            }
+        };
+        let mut u = vec![0.0; del.n()];
+        for (w, ub) in weights.iter().zip(&self.u_basis) {
+            for (ui, v) in u.iter_mut().zip(ub) {
+                *ui += w * v;
+            }
+        }
+        Ok(u)
     }
 
     /// `(q(α), q'(α))`, 2p entries each.

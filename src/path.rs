@@ -10,16 +10,12 @@
 
 use std::sync::Arc;
 
-use faer::Mat;
-
 use crate::class::Class;
 use crate::error::{Error, Result};
 use crate::load::{BoundLoad, Load};
-use crate::piece::{
-    Consts, DenseLu, Guard, displacement_gaps, kernel_vector, orientation, shift_gap,
-};
+use crate::piece::{Consts, DenseLu, Guard, PieceLu, displacement_gaps, shift_gap};
 use crate::problem::Problem;
-use crate::solve::solve_fixed_alpha;
+use crate::solve::{solve_fixed_alpha, solve_with_frozen};
 
 /// Options of a path. Build with [`PathOptions::window`] and adjust the fields.
 #[derive(Debug, Clone, PartialEq)]
@@ -223,6 +219,9 @@ struct Cur {
     alpha: f64,
     /// Tangent (λ̇, α̇), unit in scaled coordinates, oriented along the path.
     t: Vec<f64>,
+    /// Factorisation of the piece Jacobian in scaled coordinates, with the scales.
+    lu: Arc<PieceLu>,
+    scales: (f64, f64),
 }
 
 /// A transition point with its continuations, kept until the next step.
@@ -250,6 +249,8 @@ struct Cand {
     t: Vec<f64>,
     orientation: i8,
     det_sign: i8,
+    lu: Arc<PieceLu>,
+    scales: (f64, f64),
 }
 
 fn sign(x: f64) -> i8 {
@@ -327,16 +328,21 @@ impl Path {
         Ok(Point { lam, alpha, q, dq })
     }
 
-    /// Force scale of a point: max(‖λ‖∞, r0 ‖q − (g, 0)‖∞).
+    /// Force scale of a point: max(‖λ‖∞, r0 ‖q − (g, 0)‖∞, r0 ‖q'‖∞ |α_end − α_start|).
+    /// The last term keeps the scale meaningful where the load passes through zero.
     fn force_scale(&self, pt: &Point) -> f64 {
         let r0 = self.problem.default_r();
         let qg = shift_gap(&pt.q, self.problem.gap());
-        inf_norm(&pt.lam).max(r0 * inf_norm(&qg)).max(1e-300)
+        inf_norm(&pt.lam)
+            .max(r0 * inf_norm(&qg))
+            .max(r0 * inf_norm(&pt.dq) * self.alpha_scale())
+            .max(1e-300)
     }
 
     fn state(&mut self, lam: &[f64], alpha: f64, classes: &[Class]) -> Result<State> {
         let f = self.load.force(alpha)?;
-        let u = self.problem.delassus().displacement(&f, lam);
+        let mut u = self.load.displacement(alpha, self.problem.delassus())?;
+        self.problem.delassus().add_compliance(lam, &mut u);
         let residual = crate::piece::residual(&self.problem, &u, lam, &f);
         let p = self.problem.p();
         Ok(State {
@@ -349,28 +355,33 @@ impl Path {
         })
     }
 
-    /// Tangent of piece `classes` at `pt`: unit in the scaled coordinates (λ/S, α/A).
-    /// Returns (t, J) or None when the piece Jacobian has rank < 2p.
-    fn tangent(&self, classes: &[Class], pt: &Point, scale: f64) -> Option<(Vec<f64>, Mat<f64>)> {
+    /// Tangent of piece `classes` at `pt` in raw coordinates, from the factorisation of
+    /// the Jacobian in scaled coordinates (λ/S, α/A) where the tangent is a unit vector.
+    /// Returns (t, factorisation, (S, A)) or None when the Jacobian has rank < 2p.
+    fn tangent(
+        &self,
+        classes: &[Class],
+        pt: &Point,
+        scale: f64,
+    ) -> Option<(Vec<f64>, PieceLu, (f64, f64))> {
         let c = self.consts();
         let m = 2 * c.p;
         let qg = shift_gap(&pt.q, self.problem.gap());
-        let (j, _) = c.jacobian(self.problem.delassus().w(), classes, &qg, &pt.dq, pt.alpha);
+        let (mut js, _) = c.jacobian(self.problem.delassus().w(), classes, &qg, &pt.dq, pt.alpha);
         let a_s = self.alpha_scale();
-        let mut js = j.clone();
         for r in 0..m {
             for col in 0..m {
                 js[(r, col)] *= scale;
             }
             js[(r, m)] *= a_s;
         }
-        let ts = kernel_vector(js.as_ref())?;
-        let mut t = ts;
+        let lu = PieceLu::new(js.as_ref())?;
+        let mut t = lu.t.clone();
         for v in t.iter_mut().take(m) {
             *v *= scale;
         }
         t[m] *= a_s;
-        Some((t, j))
+        Some((t, lu, (scale, a_s)))
     }
 
     /// Values and derivatives along `t` of all guards of `classes` at `pt`.
@@ -407,18 +418,23 @@ impl Path {
     /// Classes of node `i` whose equations and guards hold at the point (to `tol`, in
     /// force units).
     fn compatible(&self, i: usize, pt: &Point, tol: f64) -> Vec<Class> {
-        let c = self.consts();
         let w = self.problem.delassus().w();
         let qg = shift_gap(&pt.q, self.problem.gap());
         let d = displacement_gaps(w, &qg, &pt.lam);
+        self.compatible_at(i, &pt.lam, &d, tol)
+    }
+
+    /// Classes of node `i` compatible with `(λ, d)` (to `tol`, in force units).
+    fn compatible_at(&self, i: usize, lam: &[f64], d: &[f64], tol: f64) -> Vec<Class> {
+        let c = self.consts();
         let r0 = c.r0;
         Class::ALL
             .into_iter()
             .filter(|&cl| {
                 let eq_ok = c.equations(i, cl).iter().all(|e| {
                     // equations in force units: displacement rows scaled by r0 instead of r
-                    let v = e.a[0].1 * pt.lam[e.a[0].0]
-                        + e.a[1].1 * pt.lam[e.a[1].0]
+                    let v = e.a[0].1 * lam[e.a[0].0]
+                        + e.a[1].1 * lam[e.a[1].0]
                         + if e.b.1 != 0.0 {
                             e.b.1.signum() * r0 * d[e.b.0]
                         } else {
@@ -427,16 +443,87 @@ impl Path {
                     v.abs() <= tol
                 });
                 eq_ok
-                    && crate::piece::guard_kinds(cl).iter().all(|&kind| {
-                        c.guard_form(Guard { node: i, kind }).eval(&pt.lam, &d) >= -tol
-                    })
+                    && crate::piece::guard_kinds(cl)
+                        .iter()
+                        .all(|&kind| c.guard_form(Guard { node: i, kind }).eval(lam, d) >= -tol)
             })
             .collect()
+    }
+
+    /// Adds the directions of piece `classes` through `pt` that enter its region.
+    #[allow(clippy::too_many_arguments)]
+    fn push_candidates(
+        &self,
+        classes: &[Class],
+        pt: &Point,
+        scale: f64,
+        tol: f64,
+        back: Option<(&[Class], &[f64])>,
+        relaxed: bool,
+        out: &mut Vec<Cand>,
+    ) {
+        // The piece the path came from cannot continue it: its crossing guard decreases
+        // forward, and backward is where the path came from.
+        if back.is_some_and(|(bc, _)| bc == classes) {
+            return;
+        }
+        let Some((t, lu, scales)) = self.tangent(classes, pt, scale) else {
+            return;
+        };
+        let lu = Arc::new(lu);
+        for s in [1.0, -1.0] {
+            let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
+            if out.iter().any(|c| {
+                c.classes == classes && c.t.iter().zip(&ts).map(|(a, b)| a * b).sum::<f64>() > 0.0
+            }) {
+                continue;
+            }
+            let enters = self
+                .guard_table(classes, pt, Some(&ts))
+                .iter()
+                .all(|&(_, v, vd)| {
+                    if v > tol {
+                        true
+                    } else if v < -tol {
+                        false
+                    } else if relaxed {
+                        vd >= -tol
+                    } else {
+                        vd > tol
+                    }
+                });
+            if enters {
+                let orientation = if s > 0.0 {
+                    lu.orientation
+                } else {
+                    -lu.orientation
+                };
+                let m = ts.len() - 1;
+                let det_sign = if ts[m].abs() <= 1e-14 {
+                    0
+                } else {
+                    orientation * sign(ts[m])
+                };
+                out.push(Cand {
+                    orientation,
+                    classes: classes.to_vec(),
+                    t: ts,
+                    det_sign,
+                    lu: lu.clone(),
+                    scales,
+                });
+            }
+        }
     }
 
     /// Every neighbouring piece that contains `pt` and whose direction enters its region.
     /// `fixed` gives the class of every node not in `nodes`; the nodes in `nodes` take all
     /// their compatible classes. `back` = (classes, tangent) of the way the path came.
+    ///
+    /// Nodes at the *vertex* (`λ_i = 0`, `d_i = 0`: every class fits) are not enumerated
+    /// when there are more than two of them: the continuation from such a point is
+    /// positively homogeneous, so their classes are read off the solution of the
+    /// directional contact problem `ḋ = W λ̇ ± q'` (the other nodes keep their class).
     fn continuations(
         &self,
         pt: &Point,
@@ -455,66 +542,90 @@ impl Path {
                 pt.alpha
             )));
         }
+        let is_vertex: Vec<bool> = options.iter().map(|o| o.len() == 4).collect();
+        let n_vertex = is_vertex.iter().filter(|&&v| v).count();
+        let use_directional = n_vertex > 2;
+        let enumerated: Vec<usize> = (0..nodes.len())
+            .filter(|&k| !(use_directional && is_vertex[k]))
+            .collect();
+        if enumerated.len() > MAX_ENUMERATED_NODES {
+            return Err(Error::Numerical(format!(
+                "{} nodes are at a class boundary at once at alpha = {:e} (more than {MAX_ENUMERATED_NODES} cannot be enumerated)",
+                enumerated.len(),
+                pt.alpha
+            )));
+        }
         let mut out = Vec::new();
-        let mut idx = vec![0usize; nodes.len()];
+        let mut idx = vec![0usize; enumerated.len()];
         loop {
             let mut classes = fixed.to_vec();
-            for (k, &i) in nodes.iter().enumerate() {
-                classes[i] = options[k][idx[k]];
+            for (k, &e) in enumerated.iter().enumerate() {
+                classes[nodes[e]] = options[e][idx[k]];
             }
-            if let Some((t, j)) = self.tangent(&classes, pt, scale) {
-                let det_sign = {
-                    let m = 2 * self.problem.p();
-                    crate::piece::DenseLu::new(j.as_ref().subcols(0, m)).det_sign
-                };
-                for s in [1.0, -1.0] {
-                    let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
-                    if let Some((bc, bt)) = back
-                        && bc == classes.as_slice()
-                    {
-                        let dot: f64 = ts.iter().zip(bt).map(|(a, b)| a * b).sum();
-                        if dot < 0.0 {
-                            continue;
-                        }
-                    }
-                    let enters =
-                        self.guard_table(&classes, pt, Some(&ts))
+            if use_directional {
+                let frozen: Vec<Option<Class>> = (0..classes.len())
+                    .map(|i| {
+                        let v = nodes
                             .iter()
-                            .all(|&(_, v, vd)| {
-                                if v > tol {
-                                    true
-                                } else if v < -tol {
-                                    false
-                                } else if relaxed {
-                                    vd >= -tol
-                                } else {
-                                    vd > tol
-                                }
-                            });
-                    if enters {
-                        out.push(Cand {
-                            orientation: orientation(j.as_ref(), &ts),
-                            classes: classes.clone(),
-                            t: ts,
-                            det_sign,
-                        });
+                            .position(|&n| n == i)
+                            .is_some_and(|k| is_vertex[k]);
+                        (!v).then_some(classes[i])
+                    })
+                    .collect();
+                for s in [1.0, -1.0] {
+                    if let Some(cl) = self.directional_classes(pt, &frozen, s) {
+                        self.push_candidates(&cl, pt, scale, tol, back, relaxed, &mut out);
                     }
                 }
+            } else {
+                self.push_candidates(&classes, pt, scale, tol, back, relaxed, &mut out);
             }
             // next combination
             let mut k = 0;
             loop {
-                if k == nodes.len() {
+                if k == enumerated.len() {
                     return Ok(out);
                 }
                 idx[k] += 1;
-                if idx[k] < options[k].len() {
+                if idx[k] < options[enumerated[k]].len() {
                     break;
                 }
                 idx[k] = 0;
                 k += 1;
             }
         }
+    }
+
+    /// Classes of the free (vertex) nodes on the continuation with `α̇ = s`: the solution of
+    /// the contact problem for the derivatives, `ḋ = W λ̇ + s q'`, with the frozen nodes'
+    /// equations. None when that problem has no solution or a free node stays degenerate.
+    fn directional_classes(
+        &self,
+        pt: &Point,
+        frozen: &[Option<Class>],
+        s: f64,
+    ) -> Option<Vec<Class>> {
+        let qdir: Vec<f64> = pt.dq.iter().map(|v| s * v).collect();
+        let lam = solve_with_frozen(&self.problem, &qdir, None, pt.alpha, Some(frozen)).ok()?;
+        let w = self.problem.delassus().w();
+        let d = displacement_gaps(w, &qdir, &lam);
+        let r0 = self.problem.default_r();
+        let sc = inf_norm(&lam).max(r0 * inf_norm(&qdir)).max(1e-300);
+        let tol = self.opts.zero_tol * sc;
+        let mut classes = Vec::with_capacity(frozen.len());
+        for (i, f) in frozen.iter().enumerate() {
+            match f {
+                Some(c) => classes.push(*c),
+                None => {
+                    let comp = self.compatible_at(i, &lam, &d, tol);
+                    if comp.len() != 1 {
+                        return None;
+                    }
+                    classes.push(comp[0]);
+                }
+            }
+        }
+        Some(classes)
     }
 
     /// Starts (or restarts) the path at `alpha` with the fixed-α solver, from `guess`
@@ -566,12 +677,6 @@ impl Path {
                 _ => nodes.push(i),
             }
         }
-        if nodes.len() > MAX_ENUMERATED_NODES {
-            return Err(Error::Numerical(format!(
-                "the start point alpha = {alpha} is degenerate at {} nodes at once (more than {MAX_ENUMERATED_NODES}); start slightly away from it",
-                nodes.len()
-            )));
-        }
         let want = sign(self.opts.alpha_end - self.opts.alpha_start);
         let mut cands = self.continuations(&pt, &fixed, &nodes, None, false)?;
         if cands.is_empty() {
@@ -611,6 +716,8 @@ impl Path {
                 lam: pt.lam,
                 alpha,
                 t: cand.t,
+                lu: cand.lu,
+                scales: cand.scales,
             },
             end: None,
             sigma: cand.orientation,
@@ -736,9 +843,11 @@ impl Path {
             }
             (Some((s, g)), _) => {
                 let (lam, alpha) = if self.load.is_affine() {
-                    // bordered solve: [J_S; guard row] (λ, α) = (rhs, −const)
+                    // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
+                    // piece's factorisation) and τ from the guard's equation; no drift
+                    // from earlier points enters.
                     let qg = shift_gap(&pt.q, self.problem.gap());
-                    let (j, rhs) = c.jacobian(w, &cur.classes, &qg, &pt.dq, pt.alpha);
+                    let (_, rhs) = c.jacobian(w, &cur.classes, &qg, &pt.dq, pt.alpha);
                     let form = c.guard_form(g);
                     let mut row = vec![0.0; m + 1];
                     form.row(w, &pt.dq, &mut row);
@@ -750,18 +859,15 @@ impl Path {
                             .map(|(a, b)| a * b)
                             .sum::<f64>()
                         - row[m] * cur.alpha;
-                    let mut bm = Mat::<f64>::zeros(m + 1, m + 1);
-                    for r in 0..m {
-                        for col in 0..=m {
-                            bm[(r, col)] = j[(r, col)];
-                        }
+                    let (sc, a_s) = cur.scales;
+                    let mut xp = cur.lu.particular(&rhs);
+                    for v in xp.iter_mut().take(m) {
+                        *v *= sc;
                     }
-                    for col in 0..=m {
-                        bm[(m, col)] = row[col];
-                    }
-                    let mut b = rhs.clone();
-                    b.push(-c0);
-                    let x = DenseLu::new(bm.as_ref()).solve(&b);
+                    xp[m] *= a_s;
+                    let dot = |x: &[f64]| row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+                    let tau = (-c0 - dot(&xp)) / dot(&cur.t);
+                    let x: Vec<f64> = xp.iter().zip(&cur.t).map(|(a, b)| a + tau * b).collect();
                     if x.iter().all(|v| v.is_finite()) {
                         (x[..m].to_vec(), x[m])
                     } else {
@@ -796,7 +902,7 @@ impl Path {
             )
         };
         let classes = cur.classes.clone();
-        let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<(Guard, f64, f64)>)> {
+        let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<GuardRow>)> {
             let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
             let c = this.consts();
             let qg = shift_gap(&q, this.problem.gap());
@@ -885,13 +991,7 @@ impl Path {
         }
         nodes.sort_unstable();
         nodes.dedup();
-        if nodes.len() > MAX_ENUMERATED_NODES {
-            return Err(Error::Numerical(format!(
-                "{} nodes switch at once at alpha = {:e} (more than {MAX_ENUMERATED_NODES} cannot be enumerated)",
-                nodes.len(),
-                pt.alpha
-            )));
-        }
+        let pt = self.snap_to_vertex(pt, tol)?;
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
         let mut cands = self.continuations(&pt, &cur.classes, &nodes, back, false)?;
         if cands.is_empty() {
@@ -952,6 +1052,40 @@ impl Path {
                 self.trace.as_mut().expect("started").pending = Some(pending);
                 Ok(self.finish(EndReason::Bifurcation))
             }
+        }
+    }
+
+    /// At a point where every node is at the vertex (`λ = 0`, `q(α) = (g, 0)`: the load
+    /// passes through the state of zero contact forces), the exit point found from one
+    /// guard carries that guard's rounding; the exact point is `λ = 0` at the α that
+    /// minimises `‖q(α) − (g, 0)‖` (closed form for an affine load). Other points are
+    /// returned unchanged.
+    fn snap_to_vertex(&mut self, pt: Point, tol: f64) -> Result<Point> {
+        let p = self.problem.p();
+        if inf_norm(&pt.lam) > tol || (0..p).any(|i| self.compatible(i, &pt, tol).len() < 4) {
+            return Ok(pt);
+        }
+        let m = 2 * p;
+        let alpha = if self.load.is_affine() {
+            let qg = shift_gap(&pt.q, self.problem.gap());
+            let (num, den) = qg
+                .iter()
+                .zip(&pt.dq)
+                .fold((0.0, 0.0), |(a, b), (x, y)| (a + x * y, b + y * y));
+            if den > 0.0 {
+                pt.alpha - num / den
+            } else {
+                pt.alpha
+            }
+        } else {
+            pt.alpha
+        };
+        let snapped = self.point_at(vec![0.0; m], alpha)?;
+        let qg = shift_gap(&snapped.q, self.problem.gap());
+        if self.problem.default_r() * inf_norm(&qg) <= tol {
+            Ok(snapped)
+        } else {
+            Ok(pt)
         }
     }
 
@@ -1017,6 +1151,8 @@ impl Path {
             lam: pt.lam.clone(),
             alpha: pt.alpha,
             t: cand.t.clone(),
+            lu: cand.lu.clone(),
+            scales: cand.scales,
         };
         let events = pend.events_start..tr.events.len();
         let closed = tr.entries.iter().any(|(c, l, a)| {
@@ -1197,6 +1333,9 @@ impl Path {
         Ok(out)
     }
 }
+
+/// A guard with its value and its derivative along the tangent.
+type GuardRow = (Guard, f64, f64);
 
 enum Exit {
     Window(Point),

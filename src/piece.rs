@@ -301,42 +301,117 @@ fn perm_parity(fwd: &[usize]) -> i8 {
     sign
 }
 
-/// A unit vector spanning `ker J` for `J ∈ R^{m×(m+1)}` of rank m, by LU with full
-/// pivoting (`P J Qᵀ = L U`, back-substitution with the free variable set to 1).
-/// Returns `None` when the rank is below m (the last pivot is below `1e-13` of the first).
-pub(crate) fn kernel_vector(j: MatRef<'_, f64>) -> Option<Vec<f64>> {
-    let m = j.nrows();
-    let lu = j.full_piv_lu();
-    let u = lu.U();
-    let u00 = u[(0, 0)].abs();
-    if m > 0 && !(u[(m - 1, m - 1)].abs() > 1e-13 * u00) {
-        return None;
+/// The full-pivoting LU of a piece Jacobian `J ∈ R^{m×(m+1)}` (`P J Qᵀ = L U`), with the
+/// tangent and its orientation. One factorisation gives all three:
+///
+/// * `t`: the kernel vector, from `U y = 0` with the free (last pivoted) variable 1;
+/// * `orientation = sign det [J; tᵀ] = sign(P) sign(Q) Π sign(U_ii)`, because
+///   `det [U; (Q t)ᵀ] = det U₁ (1 + ‖y₁‖²)/‖y‖` for `Q t = y/‖y‖` (SPEC §4: the sign is
+///   taken from the pivots and permutation parities, never from the determinant's value);
+/// * particular solutions of `J x = b` (free variable 0) for the exact event points.
+pub(crate) struct PieceLu {
+    l: Mat<f64>,
+    u: Mat<f64>,
+    p_fwd: Vec<usize>,
+    q_fwd: Vec<usize>,
+    /// Unit kernel vector.
+    pub t: Vec<f64>,
+    /// `sign det [J; tᵀ]` for this `t`.
+    pub orientation: i8,
+}
+
+impl PieceLu {
+    /// Factorises `J` (m × (m+1)). `None` when its rank is below m (the last pivot is below
+    /// `1e-13` of the first): the piece is not a curve there.
+    pub fn new(j: MatRef<'_, f64>) -> Option<Self> {
+        let m = j.nrows();
+        let lu = j.full_piv_lu();
+        let u = lu.U().to_owned();
+        let l = lu.L().to_owned();
+        let p_fwd: Vec<usize> = lu.P().arrays().0.to_vec();
+        let q_fwd: Vec<usize> = lu.Q().arrays().0.to_vec();
+        let u00 = if m > 0 { u[(0, 0)].abs() } else { 1.0 };
+        if m > 0 && u[(m - 1, m - 1)].abs() <= 1e-13 * u00 {
+            return None;
+        }
+        let mut y = vec![0.0; m + 1];
+        y[m] = 1.0;
+        back_substitute(u.as_ref(), &mut y);
+        let mut t = vec![0.0; m + 1];
+        for (i, &f) in q_fwd.iter().enumerate() {
+            t[f] = y[i];
+        }
+        let norm = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm.is_finite() && norm > 0.0) {
+            return None;
+        }
+        t.iter_mut().for_each(|v| *v /= norm);
+        let mut orientation = perm_parity(&p_fwd) * perm_parity(&q_fwd);
+        for i in 0..m {
+            if u[(i, i)] < 0.0 {
+                orientation = -orientation;
+            }
+        }
+        Some(Self {
+            l,
+            u,
+            p_fwd,
+            q_fwd,
+            t,
+            orientation,
+        })
     }
-    // U y = 0, y_m = 1
-    let mut y = vec![0.0; m + 1];
-    y[m] = 1.0;
+
+    /// A solution of `J x = b` (the one whose free pivoted variable is 0).
+    pub fn particular(&self, b: &[f64]) -> Vec<f64> {
+        let m = self.u.nrows();
+        // L z = P b (unit lower triangular)
+        let mut z: Vec<f64> = self.p_fwd.iter().map(|&k| b[k]).collect();
+        for i in 0..m {
+            let mut s = z[i];
+            for k in 0..i {
+                s -= self.l[(i, k)] * z[k];
+            }
+            z[i] = s;
+        }
+        let mut y = z;
+        y.push(0.0);
+        // U₁ y₁ = z − u₂ y_m with y_m = 0
+        for i in (0..m).rev() {
+            let mut s = y[i];
+            for k in i + 1..m {
+                s -= self.u[(i, k)] * y[k];
+            }
+            y[i] = s / self.u[(i, i)];
+        }
+        let mut x = vec![0.0; m + 1];
+        for (i, &f) in self.q_fwd.iter().enumerate() {
+            x[f] = y[i];
+        }
+        x
+    }
+}
+
+/// `U y = 0` for the first m entries of y given `y[m]` (U is m × (m+1), upper trapezoidal).
+fn back_substitute(u: MatRef<'_, f64>, y: &mut [f64]) {
+    let m = u.nrows();
     for i in (0..m).rev() {
-        let mut s = u[(i, m)];
+        let mut s = u[(i, m)] * y[m];
         for k in i + 1..m {
             s += u[(i, k)] * y[k];
         }
         y[i] = -s / u[(i, i)];
     }
-    // x = Qᵀ y
-    let fwd = lu.Q().arrays().0;
-    let mut x = vec![0.0; m + 1];
-    for (i, &f) in fwd.iter().enumerate() {
-        x[f] = y[i];
-    }
-    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
-    if !(norm.is_finite() && norm > 0.0) {
-        return None;
-    }
-    x.iter_mut().for_each(|v| *v /= norm);
-    Some(x)
 }
 
-/// `sign det [J; tᵀ]` (the orientation of the tangent t, SPEC §4).
+/// A unit vector spanning `ker J` (see [`PieceLu`]).
+#[cfg(test)]
+pub(crate) fn kernel_vector(j: MatRef<'_, f64>) -> Option<Vec<f64>> {
+    PieceLu::new(j).map(|p| p.t)
+}
+
+/// `sign det [J; tᵀ]` by an LU of the bordered matrix (a cross-check of [`PieceLu`]).
+#[cfg(test)]
 pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
     let m = j.nrows();
     let mut b = Mat::<f64>::zeros(m + 1, m + 1);
@@ -409,10 +484,22 @@ mod tests {
         };
         for m in [1, 2, 5, 9] {
             let j = Mat::<f64>::from_fn(m, m + 1, |_, _| rnd());
+            let plu = PieceLu::new(j.as_ref()).unwrap();
             let t = kernel_vector(j.as_ref()).unwrap();
             for r in 0..m {
                 let s: f64 = (0..=m).map(|c| j[(r, c)] * t[c]).sum();
                 assert!(s.abs() < 1e-13, "row {r}: {s}");
+            }
+            // the orientation from the pivots equals the bordered determinant's sign
+            assert_eq!(plu.orientation, orientation(j.as_ref(), &t));
+            let flipped: Vec<f64> = t.iter().map(|v| -v).collect();
+            assert_eq!(-plu.orientation, orientation(j.as_ref(), &flipped));
+            // a particular solution solves J x = b
+            let b: Vec<f64> = (0..m).map(|_| rnd()).collect();
+            let x = plu.particular(&b);
+            for r in 0..m {
+                let s: f64 = (0..=m).map(|c| j[(r, c)] * x[c]).sum();
+                assert!((s - b[r]).abs() < 1e-12, "row {r}: {s} vs {}", b[r]);
             }
         }
     }

@@ -264,6 +264,34 @@ impl CsrMatrix {
             }
         }
     }
+    /// The transpose (counting sort: linear in the number of entries; rows stay sorted).
+    pub fn transpose(&self) -> CsrMatrix {
+        let mut rp = vec![0usize; self.ncols + 1];
+        for &j in &self.col_idx {
+            rp[j + 1] += 1;
+        }
+        for j in 0..self.ncols {
+            rp[j + 1] += rp[j];
+        }
+        let mut next = rp.clone();
+        let mut ci = vec![0usize; self.nnz()];
+        let mut vals = vec![0.0; self.nnz()];
+        for i in 0..self.nrows {
+            for (j, v) in self.row(i) {
+                ci[next[j]] = i;
+                vals[next[j]] = v;
+                next[j] += 1;
+            }
+        }
+        CsrMatrix {
+            nrows: self.ncols,
+            ncols: self.nrows,
+            row_ptr: rp,
+            col_idx: ci,
+            values: vals,
+        }
+    }
+
     /// Largest absolute entry (0 for an empty matrix).
     pub fn max_abs(&self) -> f64 {
         self.values.iter().fold(0.0, |m, v| m.max(v.abs()))
@@ -412,7 +440,7 @@ impl ProblemBuilder {
                 "r = {r}, must be finite and > 0"
             )));
         }
-        let lower = lower_triangle(&self.a, self.storage)?;
+        let (lower, full_a) = lower_and_full(&self.a, self.storage)?;
         // B = [N; T] as one CSR matrix (2p x n).
         let mut trip = Vec::with_capacity(self.n.nnz() + self.t.nnz());
         for i in 0..p {
@@ -420,7 +448,6 @@ impl ProblemBuilder {
             trip.extend(self.t.row(i).map(|(j, v)| (p + i, j, v)));
         }
         let b = CsrMatrix::from_triplets("B", 2 * p, n, &trip)?;
-        let full_a = full_from_lower(&lower);
         let delassus = std::sync::Arc::new(Delassus::new(&lower, &b)?);
         let r_default = delassus.default_r();
         let r = self.r.unwrap_or(r_default);
@@ -438,74 +465,62 @@ impl ProblemBuilder {
     }
 }
 
-/// Lower triangle (row ≥ col) of A as CSR, checking the storage convention.
-fn lower_triangle(a: &CsrMatrix, storage: Storage) -> Result<CsrMatrix> {
+/// Lower triangle (row ≥ col) and full storage of A, checking the storage convention and,
+/// for full storage, symmetry. Linear in the number of entries (no sorting).
+fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatrix)> {
     let n = a.nrows();
-    let mut t = Vec::with_capacity(a.nnz());
-    match storage {
-        Storage::Lower | Storage::Upper => {
-            for i in 0..n {
-                for (j, v) in a.row(i) {
-                    let ok = if storage == Storage::Lower {
-                        i >= j
-                    } else {
-                        i <= j
-                    };
-                    if !ok {
-                        return Err(Error::Csr(format!(
-                            "A (CSR, {storage:?} storage): entry ({}, {}) (1-based) lies in the other triangle",
-                            i + 1,
-                            j + 1
-                        )));
-                    }
-                    t.push((i.max(j), i.min(j), v));
+    let keep = |m: &CsrMatrix, lower: bool| {
+        let mut rp = vec![0usize; n + 1];
+        let (mut ci, mut vals) = (Vec::new(), Vec::new());
+        for i in 0..n {
+            for (j, v) in m.row(i) {
+                if (lower && j <= i) || (!lower && j >= i) {
+                    ci.push(j);
+                    vals.push(v);
                 }
             }
+            rp[i + 1] = ci.len();
         }
+        CsrMatrix {
+            nrows: n,
+            ncols: n,
+            row_ptr: rp,
+            col_idx: ci,
+            values: vals,
+        }
+    };
+    match storage {
         Storage::Full => {
-            let scale = a.max_abs();
-            // symmetry: compare with the transpose through a sorted triplet list
-            let mut upper: Vec<(usize, usize, f64)> = Vec::new();
+            let at = a.transpose();
+            let tol = 1e-10 * a.max_abs();
             for i in 0..n {
-                for (j, v) in a.row(i) {
-                    if i >= j {
-                        t.push((i, j, v));
-                    }
-                    if i <= j {
-                        upper.push((j, i, v));
-                    }
-                }
-            }
-            let lo = CsrMatrix::from_triplets("A", n, n, &t)?;
-            let up = CsrMatrix::from_triplets("A", n, n, &upper)?;
-            let tol = 1e-10 * scale;
-            for i in 0..n {
-                let mut x = lo.row(i).peekable();
-                let mut y = up.row(i).peekable();
+                let (mut x, mut y) = (a.row(i).peekable(), at.row(i).peekable());
                 loop {
-                    let (c, d) = match (x.peek(), y.peek()) {
+                    let (c, d) = match (x.peek().copied(), y.peek().copied()) {
                         (None, None) => break,
-                        (Some(&(j, v)), None) => {
+                        (Some((j, v)), None) => {
                             x.next();
                             (j, v)
                         }
-                        (None, Some(&(j, w))) => {
+                        (None, Some((j, w))) => {
                             y.next();
                             (j, -w)
                         }
-                        (Some(&(j, v)), Some(&(k, w))) => {
-                            if j == k {
+                        (Some((j, v)), Some((k, w))) => match j.cmp(&k) {
+                            std::cmp::Ordering::Equal => {
                                 x.next();
                                 y.next();
                                 (j, v - w)
-                            } else if j < k {
+                            }
+                            std::cmp::Ordering::Less => {
                                 x.next();
                                 (j, v)
-                            } else {
+                            }
+                            std::cmp::Ordering::Greater => {
                                 y.next();
                                 (k, -w)
                             }
-                        }
+                        },
                     };
                     if d.abs() > tol {
                         return Err(Error::NotSymmetric(format!(
@@ -520,24 +535,49 @@ fn lower_triangle(a: &CsrMatrix, storage: Storage) -> Result<CsrMatrix> {
                     }
                 }
             }
-            return Ok(lo);
+            Ok((keep(a, true), a.clone()))
         }
-    }
-    CsrMatrix::from_triplets("A", n, n, &t)
-}
-
-fn full_from_lower(lower: &CsrMatrix) -> CsrMatrix {
-    let n = lower.nrows();
-    let mut t = Vec::with_capacity(2 * lower.nnz());
-    for i in 0..n {
-        for (j, v) in lower.row(i) {
-            t.push((i, j, v));
-            if i != j {
-                t.push((j, i, v));
+        Storage::Lower | Storage::Upper => {
+            let lower = storage == Storage::Lower;
+            for i in 0..n {
+                for (j, _) in a.row(i) {
+                    if (lower && j > i) || (!lower && j < i) {
+                        return Err(Error::Csr(format!(
+                            "A (CSR, {storage:?} storage): entry ({}, {}) (1-based) lies in the other triangle",
+                            i + 1,
+                            j + 1
+                        )));
+                    }
+                }
             }
+            let lo = if lower { a.clone() } else { a.transpose() };
+            // full = lower + strict upper (the transpose of lower without its diagonal)
+            let up = lo.transpose();
+            let mut rp = vec![0usize; n + 1];
+            let (mut ci, mut vals) = (Vec::new(), Vec::new());
+            for i in 0..n {
+                for (j, v) in lo.row(i) {
+                    ci.push(j);
+                    vals.push(v);
+                }
+                for (j, v) in up.row(i) {
+                    if j > i {
+                        ci.push(j);
+                        vals.push(v);
+                    }
+                }
+                rp[i + 1] = ci.len();
+            }
+            let full = CsrMatrix {
+                nrows: n,
+                ncols: n,
+                row_ptr: rp,
+                col_idx: ci,
+                values: vals,
+            };
+            Ok((lo, full))
         }
     }
-    CsrMatrix::from_triplets("A", n, n, &t).expect("indices already validated")
 }
 
 /// A validated, factorised contact problem. Immutable; share it with `Arc`.

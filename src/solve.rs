@@ -20,17 +20,38 @@ use crate::piece::{Consts, DenseLu, displacement_gaps};
 /// Relative residual accepted as a solution.
 const TOL: f64 = 1e-12;
 
+/// Nodes whose class is imposed (`Some`) rather than found; used for the directional
+/// problems at vertex points of the path (see [`crate::path`]).
+pub(crate) type Frozen<'a> = Option<&'a [Option<Class>]>;
+
+fn frozen_class(frozen: Frozen<'_>, i: usize) -> Option<Class> {
+    frozen.and_then(|f| f[i])
+}
+
 /// `H2, H3` of the seed (2p values) at `λ`, and the force scale used to make it relative.
-fn h_condensed(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64]) -> (Vec<f64>, f64) {
+/// Frozen nodes contribute the residuals of their class's equations instead.
+fn h_condensed(
+    c: &Consts,
+    w: MatRef<'_, f64>,
+    qg: &[f64],
+    lam: &[f64],
+    frozen: Frozen<'_>,
+) -> (Vec<f64>, f64) {
     let p = c.p;
     let d = displacement_gaps(w, qg, lam);
     let mut h = vec![0.0; 2 * p];
     let mut scale = 1e-300f64;
     for i in 0..p {
         let (ln, lt) = (lam[i], lam[p + i]);
-        h[i] = ln - (ln - c.r * d[i]).min(0.0);
-        let b = (-c.friction[i] * ln).max(0.0);
-        h[p + i] = lt - (lt - c.r * d[p + i]).clamp(-b, b);
+        if let Some(cl) = frozen_class(frozen, i) {
+            let [e_nu, e_t] = c.equations(i, cl);
+            h[i] = e_nu.eval(lam, &d);
+            h[p + i] = e_t.eval(lam, &d);
+        } else {
+            h[i] = ln - (ln - c.r * d[i]).min(0.0);
+            let b = (-c.friction[i] * ln).max(0.0);
+            h[p + i] = lt - (lt - c.r * d[p + i]).clamp(-b, b);
+        }
         scale = scale
             .max(ln.abs())
             .max(lt.abs())
@@ -42,22 +63,31 @@ fn h_condensed(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64]) -> (Vec<
     (h, scale)
 }
 
-fn rel_residual(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64]) -> f64 {
-    let (h, s) = h_condensed(c, w, qg, lam);
+fn rel_residual(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Frozen<'_>) -> f64 {
+    let (h, s) = h_condensed(c, w, qg, lam, fr);
     h.iter().fold(0.0f64, |m, v| m.max(v.abs())) / s
 }
 
-fn merit(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64]) -> f64 {
-    let (h, _) = h_condensed(c, w, qg, lam);
+fn merit(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Frozen<'_>) -> f64 {
+    let (h, _) = h_condensed(c, w, qg, lam, fr);
     0.5 * h.iter().map(|v| v * v).sum::<f64>()
 }
 
 /// The classes of the generalized Jacobian at `λ` (projection arguments).
-fn active_classes(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64]) -> Vec<Class> {
+fn active_classes(
+    c: &Consts,
+    w: MatRef<'_, f64>,
+    qg: &[f64],
+    lam: &[f64],
+    fr: Frozen<'_>,
+) -> Vec<Class> {
     let p = c.p;
     let d = displacement_gaps(w, qg, lam);
     (0..p)
         .map(|i| {
+            if let Some(cl) = frozen_class(fr, i) {
+                return cl;
+            }
             let (ln, lt) = (lam[i], lam[p + i]);
             if ln - c.r * d[i] >= 0.0 {
                 return Class::Open;
@@ -102,14 +132,15 @@ fn newton(
     qg: &[f64],
     lam0: Vec<f64>,
     max_iter: usize,
+    fr: Frozen<'_>,
 ) -> (Vec<f64>, bool, String) {
     let mut lam = lam0;
-    let mut phi = merit(c, w, qg, &lam);
+    let mut phi = merit(c, w, qg, &lam, fr);
     for it in 0..max_iter {
-        if rel_residual(c, w, qg, &lam) <= TOL {
+        if rel_residual(c, w, qg, &lam, fr) <= TOL {
             return (lam, true, format!("Newton converged in {it} iterations"));
         }
-        let classes = active_classes(c, w, qg, &lam);
+        let classes = active_classes(c, w, qg, &lam, fr);
         let Some(ln) = solve_piece(c, w, &classes, qg) else {
             return (
                 lam,
@@ -117,7 +148,7 @@ fn newton(
                 format!("Newton: singular piece at iteration {it}"),
             );
         };
-        if rel_residual(c, w, qg, &ln) <= TOL {
+        if rel_residual(c, w, qg, &ln, fr) <= TOL {
             return (
                 ln,
                 true,
@@ -129,7 +160,7 @@ fn newton(
         let mut accepted = false;
         while tau > 1e-10 {
             let trial: Vec<f64> = lam.iter().zip(&dir).map(|(l, d)| l + tau * d).collect();
-            let pt = merit(c, w, qg, &trial);
+            let pt = merit(c, w, qg, &trial, fr);
             if pt <= (1.0 - 1e-4 * tau) * phi {
                 lam = trial;
                 phi = pt;
@@ -141,12 +172,12 @@ fn newton(
         if !accepted {
             let msg = format!(
                 "Newton: line search stalled at iteration {it} (residual {:e})",
-                rel_residual(c, w, qg, &lam)
+                rel_residual(c, w, qg, &lam, fr)
             );
             return (lam, false, msg);
         }
     }
-    let res = rel_residual(c, w, qg, &lam);
+    let res = rel_residual(c, w, qg, &lam, fr);
     (
         lam,
         false,
@@ -156,7 +187,16 @@ fn newton(
 
 /// Exact solution of the 2×2 Coulomb problem of one node: `d = d0 + W_ii λ_i`.
 /// Among the consistent classes, the one closest to `current` is taken.
-fn local_coulomb(wl: [[f64; 2]; 2], d0: [f64; 2], f: f64, current: [f64; 2]) -> [f64; 2] {
+fn local_coulomb(
+    wl: [[f64; 2]; 2],
+    d0: [f64; 2],
+    f: f64,
+    current: [f64; 2],
+    frozen: Option<Class>,
+) -> [f64; 2] {
+    if let Some(cl) = frozen {
+        return local_class(wl, d0, f, cl).unwrap_or(current);
+    }
     let mut best: Option<([f64; 2], f64)> = None;
     let mut consider = |l: [f64; 2]| {
         let dist = (l[0] - current[0]).powi(2) + (l[1] - current[1]).powi(2);
@@ -192,12 +232,37 @@ fn local_coulomb(wl: [[f64; 2]; 2], d0: [f64; 2], f: f64, current: [f64; 2]) -> 
     best.map(|b| b.0).unwrap_or(current)
 }
 
+/// The solution of one node's 2×2 equations for an imposed class (no sign checks).
+fn local_class(wl: [[f64; 2]; 2], d0: [f64; 2], f: f64, cl: Class) -> Option<[f64; 2]> {
+    match cl {
+        Class::Open => Some([0.0, 0.0]),
+        Class::Stick => {
+            let det = wl[0][0] * wl[1][1] - wl[0][1] * wl[1][0];
+            (det != 0.0).then(|| {
+                [
+                    (-d0[0] * wl[1][1] + d0[1] * wl[0][1]) / det,
+                    (-d0[1] * wl[0][0] + d0[0] * wl[1][0]) / det,
+                ]
+            })
+        }
+        Class::SlipPlus | Class::SlipMinus => {
+            let s = if cl == Class::SlipPlus { 1.0 } else { -1.0 };
+            let den = wl[0][0] + s * f * wl[0][1];
+            (den != 0.0).then(|| {
+                let ln = -d0[0] / den;
+                [ln, s * f * ln]
+            })
+        }
+    }
+}
+
 fn block_gauss_seidel(
     c: &Consts,
     w: MatRef<'_, f64>,
     qg: &[f64],
     lam0: Vec<f64>,
     sweeps: usize,
+    fr: Frozen<'_>,
 ) -> Vec<f64> {
     let p = c.p;
     let mut lam = lam0;
@@ -213,7 +278,7 @@ fn block_gauss_seidel(
                 d[a] - wl[0][0] * cur[0] - wl[0][1] * cur[1],
                 d[b] - wl[1][0] * cur[0] - wl[1][1] * cur[1],
             ];
-            let new = local_coulomb(wl, d0, c.friction[i], cur);
+            let new = local_coulomb(wl, d0, c.friction[i], cur, frozen_class(fr, i));
             let delta = [new[0] - cur[0], new[1] - cur[1]];
             if delta[0] != 0.0 || delta[1] != 0.0 {
                 for (k, dk) in d.iter_mut().enumerate() {
@@ -240,25 +305,36 @@ pub(crate) fn solve_fixed_alpha(
     guess: Option<&[f64]>,
     alpha: f64,
 ) -> Result<Vec<f64>> {
+    solve_with_frozen(problem, qg, guess, alpha, None)
+}
+
+/// As [`solve_fixed_alpha`], with the classes of some nodes imposed.
+pub(crate) fn solve_with_frozen(
+    problem: &crate::problem::Problem,
+    qg: &[f64],
+    guess: Option<&[f64]>,
+    alpha: f64,
+    fr: Frozen<'_>,
+) -> Result<Vec<f64>> {
     let c = Consts::of(problem);
     let w = problem.delassus().w();
     let m = 2 * c.p;
     let lam0 = guess.map(|g| g.to_vec()).unwrap_or_else(|| vec![0.0; m]);
     let mut notes = Vec::new();
-    let (lam, ok, msg) = newton(&c, w, qg, lam0.clone(), 200);
+    let (lam, ok, msg) = newton(&c, w, qg, lam0.clone(), 200, fr);
     if ok {
         return Ok(lam);
     }
     notes.push(msg);
-    let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20_000);
-    let (lam, ok, msg) = newton(&c, w, qg, lam_gs, 200);
+    let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20_000, fr);
+    let (lam, ok, msg) = newton(&c, w, qg, lam_gs, 200, fr);
     if ok {
         return Ok(lam);
     }
     notes.push(format!("after block Gauss-Seidel: {msg}"));
     // Last resort: the same from zero forces and from a uniform-stick start.
     for start in [vec![0.0; m], stick_start(&c, w, qg)] {
-        let (lam, ok, msg) = newton(&c, w, qg, start, 200);
+        let (lam, ok, msg) = newton(&c, w, qg, start, 200, fr);
         if ok {
             return Ok(lam);
         }

@@ -1,0 +1,121 @@
+//! Benchmark (not a test): set-up against trace time on a problem directory.
+//!
+//! ```text
+//! cargo bench --bench trace                 # ../shared/cases/sample-rect30
+//! cargo bench --bench trace -- DIR          # another problem directory
+//! FRICONT_BENCH_CASE=DIR FRICONT_BENCH_REPS=15 cargo bench --bench trace
+//! ```
+//!
+//! Set-up = building the problem (validation, sparse Cholesky of A, W = B A⁻¹ Bᵀ) and
+//! binding the load (condensed load vectors). Trace = the start solve plus every step to
+//! the end of the window, on a fresh path over the same problem. Reading the files is
+//! timed apart and counted in neither. Each is repeated (default 7 times) and the median
+//! and minimum are printed, with the ratio trace/set-up of the medians (SPEC §6 wants it
+//! below 1 for the sample).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use fricont::io::CaseData;
+use fricont::path::{Path, PathOptions};
+
+fn median_min(v: &mut [f64]) -> (f64, f64) {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    let med = if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    };
+    (med, v[0])
+}
+
+fn main() {
+    // cargo passes `--bench` (and maybe other flags) to harness-less benches: skip flags.
+    let arg_dir = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    let dir = arg_dir
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("FRICONT_BENCH_CASE").map(PathBuf::from))
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/cases/sample-rect30")
+        });
+    let reps: usize = std::env::var("FRICONT_BENCH_REPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|&k| k > 0)
+        .unwrap_or(7);
+
+    let t = Instant::now();
+    let case = match CaseData::read_dir(&dir) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("bench trace: {e}");
+            std::process::exit(2);
+        }
+    };
+    let read_s = t.elapsed().as_secs_f64();
+    let opts = PathOptions::window(case.alpha_start, case.alpha_end);
+
+    let mut setup = Vec::with_capacity(reps);
+    let mut trace = Vec::with_capacity(reps);
+    let mut start = Vec::with_capacity(reps);
+    let mut summary = String::new();
+    for _ in 0..reps {
+        let t = Instant::now();
+        let problem = Arc::new(case.problem(None).expect("problem"));
+        let path = Path::new(
+            Arc::clone(&problem),
+            case.load().expect("load"),
+            opts.clone(),
+        )
+        .expect("path");
+        setup.push(t.elapsed().as_secs_f64());
+        drop(path);
+
+        // A fresh path on the same problem: binding the load is set-up, not trace.
+        let mut path = Path::new(problem, case.load().expect("load"), opts.clone()).expect("path");
+        let t = Instant::now();
+        path.start(opts.alpha_start, None).expect("start");
+        start.push(t.elapsed().as_secs_f64());
+        let end = path.run().expect("run");
+        trace.push(t.elapsed().as_secs_f64());
+        std::hint::black_box(path.events().len());
+        summary = format!(
+            "{} events, {} pieces, end: {}",
+            path.events().len(),
+            path.pieces().len(),
+            end.name()
+        );
+    }
+    let (s_med, s_min) = median_min(&mut setup);
+    let (t_med, t_min) = median_min(&mut trace);
+    let (st_med, st_min) = median_min(&mut start);
+    println!(
+        "case {} (n = {}, p = {}), {reps} repetitions; {summary}",
+        dir.display(),
+        case.n(),
+        case.p()
+    );
+    println!("read    {:>12.6} ms (once, not counted)", read_s * 1e3);
+    println!(
+        "set-up  median {:>12.6} ms   min {:>12.6} ms   (Cholesky of A, W, condensed load)",
+        s_med * 1e3,
+        s_min * 1e3
+    );
+    println!(
+        "trace   median {:>12.6} ms   min {:>12.6} ms   (start solve + all steps)",
+        t_med * 1e3,
+        t_min * 1e3
+    );
+    println!(
+        "  of which start solve: median {:>12.6} ms   min {:>12.6} ms",
+        st_med * 1e3,
+        st_min * 1e3
+    );
+    println!(
+        "ratio trace/set-up: median {:.4}, min {:.4}",
+        t_med / s_med,
+        t_min / s_min
+    );
+}

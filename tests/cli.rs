@@ -1,0 +1,803 @@
+//! Integration tests of the `fricont` binary: the transition table and the JSON of SPEC §8
+//! on hand-derived problems and on `../shared/cases/sample-rect30`, exit status 2 with a
+//! one-line message on broken input, and a confirmation of every event of the sample by
+//! independent fixed-α solves on both sides of it.
+
+use std::path::{Path as FsPath, PathBuf};
+use std::process::{Command, Output};
+use std::sync::Arc;
+
+use serde_json::Value;
+
+use fricont::Class;
+use fricont::io::CaseData;
+use fricont::path::{Path, PathOptions};
+
+const BIN: &str = env!("CARGO_BIN_EXE_fricont");
+
+fn sample_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/cases/sample-rect30")
+}
+
+/// A fresh empty directory under the system temp dir, removed on drop.
+struct TempDir(PathBuf);
+impl TempDir {
+    fn new(tag: &str) -> Self {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static K: AtomicUsize = AtomicUsize::new(0);
+        let d = std::env::temp_dir().join(format!(
+            "fricont-cli-{tag}-{}-{}",
+            std::process::id(),
+            K.fetch_add(1, Ordering::Relaxed)
+        ));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        TempDir(d)
+    }
+    fn path(&self) -> &FsPath {
+        &self.0
+    }
+}
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn run(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("run fricont")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+// ---------------------------------------------------------------------------------------
+// Hand-derived problems: two contact nodes that do not interact.
+//
+// n = 4 dofs (u1ν, u1t, u2ν, u2t), A = diag(kν1, kt1, kν2, kt2), N = rows e1, e3,
+// T = rows e2, e4, F = 0.75 at both nodes, f(α) = f0 + α f1. For one node with stiffnesses
+// kν, kt, gap g and load (fν(α), ft(α)), H1 gives kν uν = fν + λν, kt ut = ft + λt:
+// - open: λ = 0, uν = fν/kν, ut = ft/kt; it stays open while uν < g, i.e. fν < kν g;
+// - in contact: uν = g, λν = kν g − fν (≤ 0 while fν ≥ kν g);
+//   slip±: λt = ∓F λν, kt ut = ft ∓ F λν, guard ±ut > 0;
+//   stick: ut = 0, λt = −ft, guard |ft| < −F λν = F (fν − kν g).
+//
+// Case "decoupled": kν1 = 2, kt1 = 3, g1 = 0.25, f1ν = −1 + 2α, f1t = α;
+//                   kν2 = 5, kt2 = 4, g2 = 0,    f2ν = −1 + α,  f2t = −α/2.
+// Node 1: contact when −1 + 2α = 2·0.25 → α = 0.75, where ut = 0.75/3 > 0: open → slip+.
+//   Then kt ut = α + 0.75 (1.5 − 2α) = 1.125 − 0.5 α > 0 until α = 2.25: slip+ → stick
+//   (stick guard |α| < 0.75 (2α − 1.5) ⇔ α > 2.25, consistent).
+// Node 2: contact at α = 1, where ut = −0.5/4 < 0: open → slip−. Then λν = 1 − α,
+//   kt ut = −α/2 + 0.75 (α − 1) = 0.25 α − 0.75 < 0 until α = 3: slip− → stick.
+// Window [0, 3.5]: events (0.75, 1, open→slip+), (1, 2, open→slip−),
+// (2.25, 1, slip+→stick), (3, 2, slip−→stick); the start at α = 0 is open, open.
+//
+// Case "mirror": both nodes kν = 2, kt = 3, g = 0, fν = −1 + 2α, f1t = α, f2t = −α.
+// Both touch at α = 0.5 (node 1 slip+, node 2 slip−: a degenerate transition, one event
+// per node in node order), and both stick when α = 0.75 (2α − 1) ⇔ α = 1.5.
+// ---------------------------------------------------------------------------------------
+
+struct Hand {
+    a_diag: [f64; 4],
+    gap: Option<[f64; 2]>,
+    f0: [f64; 4],
+    f1: [f64; 4],
+    window: (f64, f64),
+}
+
+const DECOUPLED: Hand = Hand {
+    a_diag: [2.0, 3.0, 5.0, 4.0],
+    gap: Some([0.25, 0.0]),
+    f0: [-1.0, 0.0, -1.0, 0.0],
+    f1: [2.0, 1.0, 1.0, -0.5],
+    window: (0.0, 3.5),
+};
+
+const MIRROR: Hand = Hand {
+    a_diag: [2.0, 3.0, 2.0, 3.0],
+    gap: None,
+    f0: [-1.0, 0.0, -1.0, 0.0],
+    f1: [2.0, 1.0, 2.0, -1.0],
+    window: (0.0, 2.0),
+};
+
+fn lines(v: &[f64]) -> String {
+    v.iter().map(|x| format!("{x}\n")).collect()
+}
+
+fn write_hand(h: &Hand, dir: &FsPath) {
+    // A as a symmetric Matrix Market file (diagonal only), with a comment and a blank line.
+    let mut a =
+        String::from("%%MatrixMarket matrix coordinate real symmetric\n% hand-made\n\n4 4 4\n");
+    for (i, v) in h.a_diag.iter().enumerate() {
+        a.push_str(&format!("{} {} {v}\n", i + 1, i + 1));
+    }
+    std::fs::write(dir.join("A.mtx"), a).unwrap();
+    std::fs::write(
+        dir.join("N.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n2 4 2\n1 1 1\n2 3 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("T.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n2 4 2\n1 2 1.0\n2 4 1e0\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("f0.txt"), lines(&h.f0)).unwrap();
+    std::fs::write(dir.join("f1.txt"), lines(&h.f1)).unwrap();
+    if let Some(g) = h.gap {
+        std::fs::write(dir.join("gap.txt"), lines(&g)).unwrap();
+    }
+    std::fs::write(
+        dir.join("meta.json"),
+        format!(
+            r#"{{"n": 4, "p": 2, "F": 0.75, "alpha_start": {}, "alpha_end": {}, "note": "hand"}}"#,
+            h.window.0, h.window.1
+        ),
+    )
+    .unwrap();
+}
+
+/// Traces `dir` with `extra` options, checks status 0 and the JSON schema, returns the JSON
+/// and the printed table.
+fn trace_json(dir: &FsPath, extra: &[&str]) -> (Value, String) {
+    let out_dir = TempDir::new("json");
+    let json_path = out_dir.path().join("out.json");
+    let mut args = vec!["trace", dir.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    args.extend_from_slice(&["--json", json_path.to_str().unwrap()]);
+    let o = run(&args);
+    assert!(
+        o.status.success(),
+        "status {:?}\nstdout:\n{}\nstderr:\n{}",
+        o.status,
+        stdout(&o),
+        stderr(&o)
+    );
+    let text = std::fs::read_to_string(&json_path).expect("JSON written");
+    let v: Value = serde_json::from_str(&text).expect("valid JSON");
+    check_schema(&v);
+    (v, stdout(&o))
+}
+
+fn num(v: &Value, what: &str) -> f64 {
+    v.as_f64()
+        .unwrap_or_else(|| panic!("{what} is not a number: {v}"))
+}
+
+fn int(v: &Value, what: &str) -> u64 {
+    v.as_u64()
+        .unwrap_or_else(|| panic!("{what} is not a non-negative integer: {v}"))
+}
+
+fn classes(v: &Value, p: u64, what: &str) -> Vec<Class> {
+    let a = v
+        .as_array()
+        .unwrap_or_else(|| panic!("{what} is not an array"));
+    assert_eq!(a.len() as u64, p, "{what}: length");
+    a.iter()
+        .map(|c| {
+            Class::from_name(c.as_str().unwrap_or_default())
+                .unwrap_or_else(|| panic!("{what}: bad class name {c}"))
+        })
+        .collect()
+}
+
+/// SPEC §8: required keys and their types, 1-based indices and nodes, events in path
+/// order (α moving along each piece's direction), pieces joined at the events, residuals
+/// ≤ 1e-12.
+fn check_schema(v: &Value) {
+    let n = int(&v["n"], "n");
+    let p = int(&v["p"], "p");
+    assert!(n >= 1 && p >= 1);
+    assert!(num(&v["r"], "r") > 0.0);
+    let a0 = num(&v["alpha_start"], "alpha_start");
+    let a1 = num(&v["alpha_end"], "alpha_end");
+    let (lo, hi) = (a0.min(a1), a0.max(a1));
+
+    let start = &v["start"];
+    assert_eq!(num(&start["alpha"], "start.alpha"), a0);
+    let start_classes = classes(&start["classes"], p, "start.classes");
+    let r0 = num(&start["residual"], "start.residual");
+    assert!((0.0..=1e-12).contains(&r0), "start residual {r0}");
+
+    let events = v["events"].as_array().expect("events array");
+    let pieces = v["pieces"].as_array().expect("pieces array");
+    let mut last_transition = 0u64;
+    let mut last_alpha = a0;
+    for (k, e) in events.iter().enumerate() {
+        assert_eq!(
+            int(&e["index"], "index"),
+            k as u64 + 1,
+            "events are 1-based, in order"
+        );
+        let node = int(&e["node"], "node");
+        assert!(node >= 1 && node <= p, "node {node} not 1-based in 1..={p}");
+        let from = Class::from_name(e["from"].as_str().expect("from")).expect("from class");
+        let to = Class::from_name(e["to"].as_str().expect("to")).expect("to class");
+        assert_ne!(from, to, "event {} changes nothing", k + 1);
+        assert!(e["fold"].is_boolean() && e["bifurcation"].is_boolean());
+        let res = num(&e["residual"], "residual");
+        assert!(
+            (0.0..=1e-12).contains(&res),
+            "event {}: residual {res}",
+            k + 1
+        );
+        let alpha = num(&e["alpha"], "alpha");
+        assert!(
+            alpha >= lo && alpha <= hi,
+            "event α {alpha} outside the window"
+        );
+        // Transition points: 1-based, non-decreasing; events of one share α and are in
+        // node order.
+        let tp = int(&e["transition"], "transition");
+        if k > 0 && tp == last_transition {
+            let prev = &events[k - 1];
+            assert_eq!(
+                num(&prev["alpha"], "alpha"),
+                alpha,
+                "same transition, same α"
+            );
+            assert!(
+                int(&prev["node"], "node") < node,
+                "node order in a transition"
+            );
+        } else {
+            assert_eq!(tp, last_transition + 1, "transition numbering");
+            // The piece between two transition points runs in its own direction.
+            let piece = &pieces[tp as usize - 1];
+            let dir = piece["direction"].as_i64().expect("direction");
+            let step = alpha - last_alpha;
+            assert!(
+                step * dir as f64 >= 0.0 && (dir != 0 || step == 0.0),
+                "event {}: α moves by {step} on a piece of direction {dir}",
+                k + 1
+            );
+        }
+        last_transition = tp;
+        last_alpha = alpha;
+    }
+    // One piece before the first transition point and one after each.
+    assert_eq!(
+        pieces.len() as u64,
+        last_transition + 1,
+        "pieces vs transitions"
+    );
+    let mut tp_alpha = vec![a0];
+    let mut tp_seen = 0;
+    for e in events {
+        let tp = int(&e["transition"], "transition");
+        if tp != tp_seen {
+            tp_alpha.push(num(&e["alpha"], "alpha"));
+            tp_seen = tp;
+        }
+    }
+    let end = &v["end"];
+    let end_alpha = num(&end["alpha"], "end.alpha");
+    let reason = end["reason"].as_str().expect("end.reason");
+    assert!(
+        [
+            "window",
+            "max_steps",
+            "closed_loop",
+            "bifurcation",
+            "failed"
+        ]
+        .contains(&reason),
+        "reason {reason}"
+    );
+    tp_alpha.push(end_alpha);
+    for (j, piece) in pieces.iter().enumerate() {
+        let c = classes(&piece["classes"], p, "piece classes");
+        if j == 0 {
+            assert_eq!(c, start_classes, "first piece has the start classes");
+        }
+        assert_eq!(num(&piece["alpha_from"], "alpha_from"), tp_alpha[j]);
+        assert_eq!(num(&piece["alpha_to"], "alpha_to"), tp_alpha[j + 1]);
+    }
+    // Each event's from/to match the classes of the pieces around its transition point.
+    for e in events {
+        let tp = int(&e["transition"], "transition") as usize;
+        let node = int(&e["node"], "node") as usize - 1;
+        let before = classes(&pieces[tp - 1]["classes"], p, "piece")[node];
+        let after = classes(&pieces[tp]["classes"], p, "piece")[node];
+        assert_eq!(before.name(), e["from"].as_str().unwrap());
+        assert_eq!(after.name(), e["to"].as_str().unwrap());
+    }
+    if reason == "window" {
+        assert!(
+            end_alpha == lo || end_alpha == hi,
+            "window end at {end_alpha}"
+        );
+    }
+    let t = &v["timing"];
+    assert!(num(&t["setup_s"], "setup_s") >= 0.0);
+    assert!(num(&t["trace_s"], "trace_s") >= 0.0);
+}
+
+/// (α, node 1-based, from, to) of the events.
+fn event_list(v: &Value) -> Vec<(f64, u64, String, String)> {
+    v["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| {
+            (
+                e["alpha"].as_f64().unwrap(),
+                e["node"].as_u64().unwrap(),
+                e["from"].as_str().unwrap().to_string(),
+                e["to"].as_str().unwrap().to_string(),
+            )
+        })
+        .collect()
+}
+
+fn assert_events(v: &Value, expected: &[(f64, u64, &str, &str)]) {
+    let got = event_list(v);
+    assert_eq!(got.len(), expected.len(), "events: {got:?}");
+    for (g, e) in got.iter().zip(expected) {
+        assert!(
+            (g.0 - e.0).abs() <= 1e-12 * e.0.abs().max(1.0),
+            "α {} vs hand-derived {}",
+            g.0,
+            e.0
+        );
+        assert_eq!(
+            (g.1, g.2.as_str(), g.3.as_str()),
+            (e.1, e.2, e.3),
+            "{got:?}"
+        );
+    }
+}
+
+#[test]
+fn hand_decoupled_events_match_the_derivation() {
+    let d = TempDir::new("dec");
+    write_hand(&DECOUPLED, d.path());
+    let (v, table) = trace_json(d.path(), &[]);
+    assert_events(
+        &v,
+        &[
+            (0.75, 1, "open", "slip+"),
+            (1.0, 2, "open", "slip-"),
+            (2.25, 1, "slip+", "stick"),
+            (3.0, 2, "slip-", "stick"),
+        ],
+    );
+    assert_eq!(v["n"], 4);
+    assert_eq!(v["p"], 2);
+    assert_eq!(v["end"]["reason"], "window");
+    assert_eq!(v["end"]["alpha"], 3.5);
+    assert_eq!(v["start"]["classes"], serde_json::json!(["open", "open"]));
+    // The table: one row per event, α with 14 significant digits, 1-based nodes.
+    assert!(table.contains("7.5000000000000e-1"), "{table}");
+    assert!(table.contains("2.2500000000000e0"), "{table}");
+    let rows: Vec<&str> = table
+        .lines()
+        .filter(|l| l.contains(" -> ") && !l.contains("before"))
+        .collect();
+    assert_eq!(rows.len(), 4, "{table}");
+    let cols: Vec<&str> = rows[1].split_whitespace().collect();
+    assert_eq!(cols, ["2", "1.0000000000000e0", "2", "open", "->", "slip-"]);
+    assert!(
+        table.contains("setup") && table.contains("trace"),
+        "{table}"
+    );
+    assert!(table.contains("reason window"), "{table}");
+}
+
+#[test]
+fn hand_decoupled_backwards_and_r_invariance() {
+    let d = TempDir::new("back");
+    write_hand(&DECOUPLED, d.path());
+    let (v, _) = trace_json(d.path(), &["--alpha-start", "3.5", "--alpha-end", "0"]);
+    assert_events(
+        &v,
+        &[
+            (3.0, 2, "stick", "slip-"),
+            (2.25, 1, "stick", "slip+"),
+            (1.0, 2, "slip-", "open"),
+            (0.75, 1, "slip+", "open"),
+        ],
+    );
+    assert_eq!(v["alpha_start"], 3.5);
+    assert_eq!(v["end"]["alpha"], 0.0);
+    let (base, _) = trace_json(d.path(), &[]);
+    for r in ["1e-3", "1", "1e3"] {
+        let (w, _) = trace_json(d.path(), &["--r", r]);
+        assert_eq!(w["r"].as_f64().unwrap(), r.parse::<f64>().unwrap());
+        let (a, b) = (event_list(&base), event_list(&w));
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(&b) {
+            assert!((x.0 - y.0).abs() <= 1e-12 * x.0.abs().max(1.0), "r = {r}");
+            assert_eq!((x.1, &x.2, &x.3), (y.1, &y.2, &y.3));
+        }
+    }
+}
+
+#[test]
+fn hand_mirror_degenerate_transition_one_event_per_node() {
+    let d = TempDir::new("mirror");
+    write_hand(&MIRROR, d.path());
+    let (v, table) = trace_json(d.path(), &[]);
+    assert_events(
+        &v,
+        &[
+            (0.5, 1, "open", "slip+"),
+            (0.5, 2, "open", "slip-"),
+            (1.5, 1, "slip+", "stick"),
+            (1.5, 2, "slip-", "stick"),
+        ],
+    );
+    let tps: Vec<u64> = v["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["transition"].as_u64().unwrap())
+        .collect();
+    assert_eq!(tps, [1, 1, 2, 2]);
+    assert_eq!(v["pieces"].as_array().unwrap().len(), 3);
+    assert!(table.contains("5.0000000000000e-1"), "{table}");
+}
+
+#[test]
+fn max_steps_stops_the_path() {
+    let d = TempDir::new("max");
+    write_hand(&DECOUPLED, d.path());
+    let (v, _) = trace_json(d.path(), &["--max-steps", "2"]);
+    assert_eq!(v["end"]["reason"], "max_steps");
+    assert_events(&v, &[(0.75, 1, "open", "slip+"), (1.0, 2, "open", "slip-")]);
+}
+
+/// A one-node problem with two non-smooth folds (Klarbring's coupling).
+///
+/// n = 2, A = [[1, ½], [½, 1]] (det D = ¾), N = [1 0], T = [0 1], g = 0, F = 3,
+/// f(α) = (1, α). With B = I, d = A⁻¹(f + λ); write s = fν − ½ ft (so dν = s/D when open).
+/// - open: λ = 0, guard dν = s/D < 0 ⇔ α > 2; there dt = (α − ½)/D > 0;
+/// - slip+: λt = F λν, dν = 0 ⇒ λν (1 − ½F) = −s ⇒ λν = 2s = 2 − α, guard λν < 0 ⇔ α > 2;
+///   dt = (−½(1 + λν) + α + 3 λν)/D = (4.5 − 1.5 α)/D > 0 ⇔ α < 3;
+/// - stick: λ = −f = (−1, −α), guard |α| < F·1 = 3;
+/// - slip−: λt = −F λν ⇒ λν = −s/(1 + ½F) = −(1 − α/2)/2.5, dt = (0.9 + 0.3 α)/D < 0 ⇔ α < −3.
+/// Traced from α = 4 toward −4: open (α decreasing) until α = 2 where contact closes with
+/// dt > 0 into slip+, which exists only for α ∈ (2, 3): α turns back (fold 1); slip+ → stick
+/// at α = 3 where dt reaches 0, and stick exists for α < 3: α turns back again (fold 2);
+/// stick → slip− at α = −3 (no fold). For α ∈ (2, 3) there are three solutions.
+#[test]
+fn hand_two_folds_are_flagged() {
+    let d = TempDir::new("fold");
+    let dir = d.path();
+    std::fs::write(
+        dir.join("A.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n2 2 4\n1 1 1\n1 2 0.5\n2 1 0.5\n2 2 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("N.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n1 2 1\n1 1 1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("T.mtx"),
+        "%%MatrixMarket matrix coordinate real general\n1 2 1\n1 2 1\n",
+    )
+    .unwrap();
+    std::fs::write(dir.join("f0.txt"), "1\n0\n").unwrap();
+    std::fs::write(dir.join("f1.txt"), "0\n1\n").unwrap();
+    std::fs::write(
+        dir.join("meta.json"),
+        r#"{"n": 2, "p": 1, "F": 3, "alpha_start": 4, "alpha_end": -4}"#,
+    )
+    .unwrap();
+    let (v, table) = trace_json(dir, &[]);
+    assert_events(
+        &v,
+        &[
+            (2.0, 1, "open", "slip+"),
+            (3.0, 1, "slip+", "stick"),
+            (-3.0, 1, "stick", "slip-"),
+        ],
+    );
+    let folds: Vec<bool> = v["events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["fold"].as_bool().unwrap())
+        .collect();
+    assert_eq!(folds, [true, true, false]);
+    let dirs: Vec<i64> = v["pieces"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["direction"].as_i64().unwrap())
+        .collect();
+    assert_eq!(dirs, [-1, 1, -1, -1]);
+    assert_eq!(v["end"]["alpha"], -4.0);
+    let fold_rows = table.lines().filter(|l| l.ends_with("fold")).count();
+    assert_eq!(fold_rows, 2, "{table}");
+}
+
+// ---------------------------------------------------------------------------------------
+// Bad input: exit status 2 and one line on stderr naming the culprit.
+// ---------------------------------------------------------------------------------------
+
+/// Runs `trace` on a copy of DECOUPLED with `file` replaced (or removed if `None`); checks
+/// status 2, nothing on stdout, one line on stderr containing every `needles` string.
+fn expect_input_error(file: &str, content: Option<&str>, needles: &[&str]) {
+    let d = TempDir::new("broken");
+    write_hand(&DECOUPLED, d.path());
+    match content {
+        Some(c) => std::fs::write(d.path().join(file), c).unwrap(),
+        None => std::fs::remove_file(d.path().join(file)).unwrap(),
+    }
+    let o = run(&["trace", d.path().to_str().unwrap()]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{file}: stderr {err}");
+    assert_eq!(err.lines().count(), 1, "one line expected: {err}");
+    assert!(stdout(&o).is_empty(), "nothing on stdout: {}", stdout(&o));
+    for n in needles {
+        assert!(err.contains(n), "{file}: {err:?} lacks {n:?}");
+    }
+}
+
+#[test]
+fn broken_matrix_market_files() {
+    expect_input_error("A.mtx", None, &["A.mtx", "cannot read"]);
+    expect_input_error(
+        "A.mtx",
+        Some("%%MatrixMarket matrix array real general\n4 4\n"),
+        &["A.mtx:1:", "bad header"],
+    );
+    expect_input_error(
+        "N.mtx",
+        Some("%%MatrixMarket matrix coordinate real general\n2 4 2\n1 1 1\n"),
+        &["N.mtx", "only 1 entries, 2 announced"],
+    );
+    expect_input_error(
+        "N.mtx",
+        Some("%%MatrixMarket matrix coordinate real general\n2 4 2\n1 1 1\n3 3 1\n"),
+        &["N.mtx:4:", "row index 3 out of range"],
+    );
+    expect_input_error(
+        "T.mtx",
+        Some("%%MatrixMarket matrix coordinate real general\n2 4 2\n1 2 x\n2 4 1\n"),
+        &["T.mtx:3:", "not a number"],
+    );
+    expect_input_error(
+        "A.mtx",
+        Some(
+            "%%MatrixMarket matrix coordinate real general\n4 4 4\n1 1 2\n2 2 NaN\n3 3 5\n4 4 4\n",
+        ),
+        &["A.mtx:4:", "NaN"],
+    );
+    expect_input_error(
+        "T.mtx",
+        Some("%%MatrixMarket matrix coordinate real general\n2 5 2\n1 2 1\n2 4 1\n"),
+        &["T.mtx:2:", "expected 2x4"],
+    );
+}
+
+#[test]
+fn broken_vectors_and_meta() {
+    expect_input_error("f0.txt", Some("-1\n0\n-1\n"), &["f0.txt", "expected n = 4"]);
+    expect_input_error("f1.txt", Some("2\n1\n1e999\n-0.5\n"), &["f1.txt:3:", "inf"]);
+    expect_input_error("gap.txt", Some("0.25\nzero\n"), &["gap.txt:2:", "\"zero\""]);
+    expect_input_error("meta.json", None, &["meta.json", "cannot read"]);
+    expect_input_error(
+        "meta.json",
+        Some(r#"{"n": 4, "p": 2, "alpha_start": 0, "alpha_end": 1}"#),
+        &["meta.json", "\"F\""],
+    );
+    expect_input_error(
+        "meta.json",
+        Some(r#"{"n": 5, "p": 2, "F": 0.5, "alpha_start": 0, "alpha_end": 1}"#),
+        &["A.mtx", "expected 5x5"],
+    );
+    expect_input_error(
+        "meta.json",
+        Some(r#"{"n": 4, "p": 2, "F": 0.5, "alpha_start": 1, "alpha_end": 1}"#),
+        &["window"],
+    );
+}
+
+#[test]
+fn data_rejected_by_the_problem_builder() {
+    // A not positive definite.
+    expect_input_error(
+        "A.mtx",
+        Some("%%MatrixMarket matrix coordinate real general\n4 4 4\n1 1 2\n2 2 -3\n3 3 5\n4 4 4\n"),
+        &["positive definite"],
+    );
+    // A not symmetric (general file).
+    expect_input_error(
+        "A.mtx",
+        Some(
+            "%%MatrixMarket matrix coordinate real general\n4 4 5\n1 1 2\n2 2 3\n3 3 5\n4 4 4\n1 2 1\n",
+        ),
+        &["symmetric"],
+    );
+    // B = [N; T] rank-deficient: T's second row equals N's second row.
+    expect_input_error(
+        "T.mtx",
+        Some("%%MatrixMarket matrix coordinate real general\n2 4 2\n1 2 1\n2 3 1\n"),
+        &["rank"],
+    );
+    // Negative friction.
+    expect_input_error(
+        "meta.json",
+        Some(r#"{"n": 4, "p": 2, "F": [0.5, -1], "alpha_start": 0, "alpha_end": 1}"#),
+        &["meta.json", ">= 0"],
+    );
+}
+
+#[test]
+fn bad_options_exit_2() {
+    let d = TempDir::new("opts");
+    write_hand(&DECOUPLED, d.path());
+    let dir = d.path().to_str().unwrap();
+    for args in [
+        vec!["trace", dir, "--r", "-1"],
+        vec!["trace", dir, "--r", "abc"],
+        vec!["trace", dir, "--alpha-start", "2", "--alpha-end", "2"],
+        vec!["trace"],
+        vec!["frobnicate"],
+    ] {
+        let o = run(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
+        assert!(!stderr(&o).is_empty());
+    }
+}
+
+#[test]
+fn broken_copy_of_the_sample() {
+    // The sample with a meta.json that disagrees with its matrices.
+    let d = TempDir::new("samplebad");
+    for f in ["A.mtx", "N.mtx", "T.mtx", "f0.txt", "f1.txt", "gap.txt"] {
+        std::fs::copy(sample_dir().join(f), d.path().join(f)).unwrap();
+    }
+    std::fs::write(
+        d.path().join("meta.json"),
+        r#"{"n": 1320, "p": 31, "F": 0.3, "alpha_start": -0.5, "alpha_end": 1.5}"#,
+    )
+    .unwrap();
+    let o = run(&["trace", d.path().to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("N.mtx:3:"), "{}", stderr(&o));
+    assert!(stderr(&o).contains("expected 31x1320"), "{}", stderr(&o));
+}
+
+// ---------------------------------------------------------------------------------------
+// The sample.
+// ---------------------------------------------------------------------------------------
+
+#[test]
+fn sample_runs_through_the_cli() {
+    let (v, table) = trace_json(&sample_dir(), &[]);
+    assert_eq!(v["n"], 1320);
+    assert_eq!(v["p"], 30);
+    assert_eq!(v["alpha_start"], -0.5);
+    assert_eq!(v["alpha_end"], 1.5);
+    assert_eq!(v["end"]["reason"], "window");
+    let events = v["events"].as_array().unwrap();
+    assert!(!events.is_empty(), "the sample has transition points");
+    // The JSON is the library's path, α exactly (serde_json writes round-trip numbers).
+    let case = CaseData::read_dir(&sample_dir()).unwrap();
+    let problem = Arc::new(case.problem(None).unwrap());
+    let opts = PathOptions::window(case.alpha_start, case.alpha_end);
+    let mut path = Path::new(problem, case.load().unwrap(), opts).unwrap();
+    path.start(case.alpha_start, None).unwrap();
+    path.run().unwrap();
+    assert_eq!(path.events().len(), events.len());
+    for (e, j) in path.events().iter().zip(events) {
+        assert_eq!(e.alpha.to_bits(), j["alpha"].as_f64().unwrap().to_bits());
+        assert_eq!(e.node as u64 + 1, j["node"].as_u64().unwrap());
+        assert_eq!(e.from.name(), j["from"].as_str().unwrap());
+        assert_eq!(e.to.name(), j["to"].as_str().unwrap());
+    }
+    // Every event has a table row with its 1-based node and its α to 14 digits.
+    for e in events {
+        let alpha = format!("{:.13e}", e["alpha"].as_f64().unwrap());
+        let node = e["node"].as_u64().unwrap().to_string();
+        assert!(
+            table.lines().any(|l| {
+                let c: Vec<&str> = l.split_whitespace().collect();
+                c.len() >= 6 && c[1] == alpha && c[2] == node
+            }),
+            "no row for α {alpha}, node {node}:\n{table}"
+        );
+    }
+}
+
+/// Every event of the sample is confirmed by fixed-α solves on fresh paths at α ∓ δ, with
+/// δ a quarter of the distance to the neighbouring transition points (capped at 1e-3 of
+/// the window): the node's class there is the reported `from` and `to`, and the whole class
+/// vector and the contact forces agree with the traced path's own solution at α ∓ δ.
+#[test]
+fn sample_events_confirmed_by_fixed_alpha_solves() {
+    let case = CaseData::read_dir(&sample_dir()).unwrap();
+    let problem = Arc::new(case.problem(None).unwrap());
+    let opts = PathOptions::window(case.alpha_start, case.alpha_end);
+    let mut path = Path::new(Arc::clone(&problem), case.load().unwrap(), opts.clone()).unwrap();
+    path.start(case.alpha_start, None).unwrap();
+    path.run().unwrap();
+    let events = path.events().to_vec();
+    let pieces = path.pieces().to_vec();
+    assert!(!events.is_empty());
+    // α of each transition point, with the window ends as outer neighbours.
+    let mut tp_alpha = vec![case.alpha_start];
+    for e in &events {
+        if e.transition + 1 == tp_alpha.len() {
+            tp_alpha.push(e.alpha);
+        }
+    }
+    tp_alpha.push(case.alpha_end);
+    let width = (case.alpha_end - case.alpha_start).abs();
+    let fresh_classes = |alpha: f64| -> (Vec<Class>, Vec<f64>) {
+        let mut p = Path::new(Arc::clone(&problem), case.load().unwrap(), opts.clone()).unwrap();
+        p.start(alpha, None)
+            .unwrap_or_else(|e| panic!("fixed-α solve at {alpha}: {e}"));
+        let s = p.start_state().unwrap();
+        assert!(
+            s.residual <= 1e-12,
+            "fixed-α residual {} at {alpha}",
+            s.residual
+        );
+        (s.classes.clone(), s.lambda_n.clone())
+    };
+    let mut confirmed = 0;
+    for e in &events {
+        let t = e.transition + 1; // position in tp_alpha
+        let gap = (tp_alpha[t] - tp_alpha[t - 1])
+            .abs()
+            .min((tp_alpha[t + 1] - tp_alpha[t]).abs());
+        assert!(gap > 0.0, "two transition points at the same α {}", e.alpha);
+        let delta = (0.25 * gap).min(1e-3 * width);
+        let before = &pieces[e.transition];
+        let after = &pieces[e.transition + 1];
+        assert!(
+            before.direction != 0 && after.direction != 0,
+            "vertical piece in the sample at α = {}",
+            e.alpha
+        );
+        assert!(
+            !e.fold && before.direction == after.direction,
+            "fold in the sample at α = {} (F = 0.3: none expected)",
+            e.alpha
+        );
+        let d = f64::from(before.direction);
+        let (a_before, a_after) = (e.alpha - d * delta, e.alpha + d * delta);
+        let (cb, ln_b) = fresh_classes(a_before);
+        let (ca, ln_a) = fresh_classes(a_after);
+        assert_eq!(
+            cb[e.node],
+            e.from,
+            "node {} before α = {}",
+            e.node + 1,
+            e.alpha
+        );
+        assert_eq!(
+            ca[e.node],
+            e.to,
+            "node {} after α = {}",
+            e.node + 1,
+            e.alpha
+        );
+        assert_eq!(cb, before.classes, "classes before α = {}", e.alpha);
+        assert_eq!(ca, after.classes, "classes after α = {}", e.alpha);
+        // The traced path's own solution at α ∓ δ (one piece solve) agrees.
+        for (alpha, ln) in [(a_before, &ln_b), (a_after, &ln_a)] {
+            let sols = path.solutions_at(alpha).unwrap();
+            assert_eq!(sols.len(), 1, "one solution at {alpha}");
+            let scale = ln.iter().fold(1e-300_f64, |m, x| m.max(x.abs()));
+            for (x, y) in sols[0].state.lambda_n.iter().zip(ln) {
+                assert!((x - y).abs() <= 1e-9 * scale, "λν {x} vs {y} at {alpha}");
+            }
+        }
+        confirmed += 1;
+    }
+    assert_eq!(confirmed, events.len());
+}
