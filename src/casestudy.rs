@@ -146,6 +146,28 @@ pub struct CaseStudyReport {
     pub fold: Option<FoldReport>,
 }
 
+impl CaseStudyReport {
+    /// Everything the CLI prints: the main table, the high-friction variant's table, the
+    /// timings and the list of files written. Ends with a newline.
+    pub fn text(&self) -> String {
+        let mut s = self.table.clone();
+        if let Some(f) = &self.fold {
+            s.push_str("\nhigh-friction variant:\n");
+            s.push_str(&f.table);
+        }
+        let _ = writeln!(
+            s,
+            "\nset-up {:.3} s, tracing {:.3} s (main path); Figure 2 at alpha = {}",
+            self.setup_s, self.trace_s, self.snapshot_alpha
+        );
+        let _ = writeln!(s, "files written:");
+        for f in &self.files {
+            let _ = writeln!(s, "  {}", f.display());
+        }
+        s
+    }
+}
+
 /// α with 14 significant digits in plain notation when reasonable (`0.28019791259766`),
 /// in scientific notation otherwise.
 pub fn fmt_alpha14(x: f64) -> String {
@@ -663,7 +685,7 @@ pub fn plot_mesh(spec: &RectSpec, file: &FsPath) -> Result<()> {
             (&spec.load0, PALETTE[0], "f0"),
             (&spec.load1, PALETTE[2], "α·f1"),
         ];
-        for (tracs, color, name) in loads {
+        for (li, (tracs, color, name)) in loads.into_iter().enumerate() {
             let maxmag = tracs
                 .iter()
                 .flat_map(|t| [t.start, t.end])
@@ -674,9 +696,11 @@ pub fn plot_mesh(spec: &RectSpec, file: &FsPath) -> Result<()> {
             }
             let mut first = true;
             for t in tracs.iter() {
+                // f0 arrows at the ends and every eighth of the side, α·f1 arrows halfway
+                // between them, so the two loads do not hide each other
                 let m = 8;
-                for k in 0..=m {
-                    let s = k as f64 / m as f64;
+                for k in 0..=(m - li) {
+                    let s = (k as f64 + 0.5 * li as f64) / m as f64;
                     let (x, y) = match t.side {
                         Side::Bottom => (s * lx, 0.0),
                         Side::Top => (s * lx, ly),
@@ -722,7 +746,7 @@ pub fn plot_mesh(spec: &RectSpec, file: &FsPath) -> Result<()> {
                             tracs
                                 .iter()
                                 .map(|t| format!(
-                                    "{} ({:.3}, {:.3}) → ({:.3}, {:.3})",
+                                    "{} ({}, {}) → ({}, {})",
                                     t.side.name(),
                                     t.start[0],
                                     t.start[1],
@@ -987,7 +1011,7 @@ fn draw_points<'a, 'b: 'a>(
         let mut clusters: Vec<(usize, Vec<usize>)> = Vec::new();
         for (k, m) in points.iter().enumerate() {
             match clusters.last_mut() {
-                Some((first, ts)) if (points[*first].alpha - m.alpha).abs() < 0.02 * alpha_span => {
+                Some((first, ts)) if (points[*first].alpha - m.alpha).abs() < 0.04 * alpha_span => {
                     if !ts.contains(&m.transition) {
                         ts.push(m.transition);
                     }
@@ -1477,6 +1501,42 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
     })
 }
 
+/// The parts of the pieces with α in `[lo, hi]` (pieces of an affine load are straight
+/// segments in (α, λ), so cutting them is a linear interpolation; vertical pieces are
+/// kept when their α is inside).
+pub fn clip_pieces(pieces: &[PieceLine], lo: f64, hi: f64) -> Vec<PieceLine> {
+    let lerp = |a: &[f64], b: &[f64], t: f64| -> Vec<f64> {
+        a.iter().zip(b).map(|(x, y)| x + t * (y - x)).collect()
+    };
+    let mut out = Vec::new();
+    for p in pieces {
+        let (a0, a1) = (p.alpha_from, p.alpha_to);
+        if a0 == a1 {
+            if (lo..=hi).contains(&a0) {
+                out.push(p.clone());
+            }
+            continue;
+        }
+        let t = |a: f64| ((a - a0) / (a1 - a0)).clamp(0.0, 1.0);
+        let (ta, tb) = {
+            let (x, y) = (t(lo), t(hi));
+            (x.min(y), x.max(y))
+        };
+        if tb <= ta {
+            continue;
+        }
+        out.push(PieceLine {
+            alpha_from: a0 + ta * (a1 - a0),
+            alpha_to: a0 + tb * (a1 - a0),
+            lambda_n_from: lerp(&p.lambda_n_from, &p.lambda_n_to, ta),
+            lambda_n_to: lerp(&p.lambda_n_from, &p.lambda_n_to, tb),
+            lambda_t_from: lerp(&p.lambda_t_from, &p.lambda_t_to, ta),
+            lambda_t_to: lerp(&p.lambda_t_from, &p.lambda_t_to, tb),
+        });
+    }
+    out
+}
+
 /// An α inside a fold region where the traced path has the most solutions: the middle
 /// of the widest gap between consecutive distinct transition α's among the gaps covered
 /// by the largest number of traced (non-vertical) pieces. `None` when no α has two.
@@ -1595,6 +1655,40 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
         &out.join("path.svg"),
     )?;
     files.push(out.join("path.svg"));
+    // a zoom on the folds
+    let fold_alphas: Vec<f64> = rows.iter().filter(|r| r.fold).map(|r| r.alpha).collect();
+    if !fold_alphas.is_empty() {
+        let (lo, hi) = fold_alphas
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                (a.min(x), b.max(x))
+            });
+        let w = (hi - lo).max(1e-3 * (spec.alpha_end - spec.alpha_start).abs());
+        let (lo, hi) = (lo - 0.15 * w, hi + 0.15 * w);
+        let pieces = clip_pieces(&piece_lines(&tr.path), lo, hi);
+        let points: Vec<MarkedPoint> = marked_points(&tr.path)
+            .into_iter()
+            .filter(|m| (lo..=hi).contains(&m.alpha))
+            .collect();
+        let mut nodes: Vec<usize> = Vec::new();
+        for m in &points {
+            if !nodes.contains(&m.node) && nodes.len() < 8 {
+                nodes.push(m.node);
+            }
+        }
+        nodes.sort_unstable();
+        plot_path(
+            &pieces,
+            &points,
+            &nodes,
+            &format!(
+                "High-friction variant (F = {}): zoom on the folds, α ∈ [{:.4}, {:.4}]",
+                spec.friction, lo, hi
+            ),
+            &out.join("path_folds.svg"),
+        )?;
+        files.push(out.join("path_folds.svg"));
+    }
     let js = path_json(&mut tr.path, &case, tr.setup_s, tr.trace_s)?;
     write(
         out.join("path.json"),
