@@ -1413,8 +1413,11 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
         } else {
             snap_alpha - 0.05 * (hi - lo)
         };
-        let mut ext = trace(&case, problem.clone(), spec.alpha_start, beyond)?;
-        ext.path.solutions_at(snap_alpha)?
+        // a failure of the extended path only costs the snapshot its α (fallback below)
+        match trace(&case, problem.clone(), spec.alpha_start, beyond) {
+            Ok(mut ext) => ext.path.solutions_at(snap_alpha).unwrap_or_default(),
+            Err(_) => Vec::new(),
+        }
     };
     let snap_sols = if snap_sols.is_empty() {
         snap_alpha = spec.alpha_end;
@@ -1711,6 +1714,26 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn clipping_a_piece_interpolates_its_end_points() {
+        let p = PieceLine {
+            alpha_from: 1.0,
+            alpha_to: 0.0,
+            lambda_n_from: vec![-2.0],
+            lambda_n_to: vec![0.0],
+            lambda_t_from: vec![1.0],
+            lambda_t_to: vec![3.0],
+        };
+        let c = clip_pieces(std::slice::from_ref(&p), 0.25, 0.5);
+        assert_eq!(c.len(), 1);
+        assert_eq!((c[0].alpha_from, c[0].alpha_to), (0.5, 0.25));
+        assert_eq!((c[0].lambda_n_from[0], c[0].lambda_n_to[0]), (-1.0, -0.5));
+        assert_eq!((c[0].lambda_t_from[0], c[0].lambda_t_to[0]), (2.0, 2.5));
+        assert!(clip_pieces(std::slice::from_ref(&p), 2.0, 3.0).is_empty());
+        let v = PieceLine { alpha_to: 1.0, ..p };
+        assert_eq!(clip_pieces(std::slice::from_ref(&v), 0.5, 1.5).len(), 1);
+    }
 
     #[test]
     fn alpha_has_14_significant_digits() {
