@@ -228,6 +228,60 @@ fn printed_transitions_agree_with_tracing_the_files_read_back() {
 }
 
 #[test]
+fn printed_transitions_agree_with_the_fricont_trace_binary() {
+    // The acceptance criterion literally: `fricont trace DIR --json FILE` on the files the
+    // case study wrote gives the events it printed.
+    let out = tmp("cs-binary");
+    let mut opts = CaseStudyOptions::new(&out);
+    opts.profile_alphas = vec![0.0];
+    let report = run(&opts).unwrap();
+    for (dir, table) in [
+        (out.join("problem"), report.table.clone()),
+        (
+            out.join("high-friction").join("problem"),
+            report.fold.as_ref().unwrap().table.clone(),
+        ),
+    ] {
+        let json = out.join("trace.json");
+        let st = std::process::Command::new(env!("CARGO_BIN_EXE_fricont"))
+            .arg("trace")
+            .arg(&dir)
+            .arg("--json")
+            .arg(&json)
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        let js: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let ev = js["events"].as_array().unwrap();
+        let printed = parse_table(&table);
+        assert_eq!(ev.len(), printed.len(), "{}", dir.display());
+        for (j, p) in ev.iter().zip(&printed) {
+            assert_eq!(j["node"].as_u64().unwrap() as usize, p.node);
+            let words = |name: &str| Class::from_name(name).unwrap().words();
+            assert_eq!(words(j["from"].as_str().unwrap()), p.from);
+            assert_eq!(words(j["to"].as_str().unwrap()), p.to);
+            assert_eq!(j["fold"].as_bool().unwrap(), p.fold);
+            let a = j["alpha"].as_f64().unwrap();
+            assert!(
+                (a - p.alpha).abs() <= 1e-12,
+                "{}: transition {}: printed {} vs fricont trace {a}",
+                dir.display(),
+                p.transition,
+                p.alpha
+            );
+        }
+        assert_eq!(js["end"]["reason"], "window");
+    }
+    assert_eq!(report.snapshot_alpha, 3.6, "Figure 2 shows the paper's α");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
 fn the_reconstruction_shows_the_papers_kinds_of_transitions() {
     // The claims of docs/case-study.md about the default reconstruction.
     let spec = RectSpec::default();
@@ -261,15 +315,16 @@ fn cheap_solutions_at_any_alpha_agree_with_a_fresh_fixed_alpha_solve() {
     let spec = RectSpec::default();
     let case = generate(&spec).unwrap();
     let problem = Arc::new(case.problem(None).unwrap());
+    // the window of Figure 2's extended path (the paper's snapshot is at α = 3.6)
     let mut path = Path::new(
         problem.clone(),
         case.load().unwrap(),
-        PathOptions::window(-0.5, 1.5),
+        PathOptions::window(-0.5, 3.7),
     )
     .unwrap();
     path.start(-0.5, None).unwrap();
     path.run().unwrap();
-    for alpha in [-0.5, -0.1234, 0.0, 0.5, 1.0, 1.37, 1.5] {
+    for alpha in [-0.5, -0.1234, 0.0, 0.5, 1.0, 1.37, 1.5, 3.6] {
         let sols = path.solutions_at(alpha).unwrap();
         assert_eq!(sols.len(), 1, "α = {alpha}: F = 0.3 has one solution");
         let s = &sols[0].state;
@@ -278,7 +333,7 @@ fn cheap_solutions_at_any_alpha_agree_with_a_fresh_fixed_alpha_solve() {
         let mut fresh = Path::new(
             problem.clone(),
             case.load().unwrap(),
-            PathOptions::window(alpha, if alpha < 1.5 { 1.5 } else { -0.5 }),
+            PathOptions::window(alpha, if alpha < 3.7 { 3.7 } else { -0.5 }),
         )
         .unwrap();
         fresh.start(alpha, None).unwrap();
