@@ -424,3 +424,40 @@ fn high_friction_variant_folds_and_its_solutions_are_distinct_and_genuine() {
     assert!(fr.solutions >= 2);
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+#[test]
+fn case_study_transitions_do_not_depend_on_r() {
+    // SPEC §1: solutions and transition points do not depend on the augmentation r.
+    for spec in [RectSpec::default(), RectSpec::high_friction()] {
+        let case = generate(&spec).unwrap();
+        let r0 = case.problem(None).unwrap().default_r();
+        let mut runs = Vec::new();
+        for r in [r0, 1e-3 * r0, 1e3 * r0] {
+            let problem = Arc::new(case.problem(Some(r)).unwrap());
+            let mut path = Path::new(
+                problem,
+                case.load().unwrap(),
+                PathOptions::window(spec.alpha_start, spec.alpha_end),
+            )
+            .unwrap();
+            path.start(spec.alpha_start, None).unwrap();
+            path.run().unwrap();
+            runs.push(path.events().to_vec());
+        }
+        for other in &runs[1..] {
+            assert_eq!(other.len(), runs[0].len(), "{}", spec.load_name);
+            for (a, b) in runs[0].iter().zip(other) {
+                assert_eq!(
+                    (a.node, a.from, a.to, a.fold),
+                    (b.node, b.from, b.to, b.fold)
+                );
+                assert!(
+                    (a.alpha - b.alpha).abs() <= 1e-12,
+                    "{} vs {}",
+                    a.alpha,
+                    b.alpha
+                );
+            }
+        }
+    }
+}
