@@ -13,7 +13,9 @@
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError as DenseLltError;
-use faer::sparse::linalg::cholesky::{LltRef, SymbolicCholesky, factorize_symbolic_cholesky};
+use faer::sparse::linalg::cholesky::{
+    LltRef, SymbolicCholesky, SymbolicCholeskyRaw, factorize_symbolic_cholesky,
+};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
 
@@ -76,11 +78,15 @@ impl Delassus {
             if let Err(e) = res {
                 return Err(match e {
                     DenseLltError::NonPositivePivot { index } => {
-                        let row = symbolic
-                            .perm()
-                            .map(|p| p.arrays().0[index])
-                            .unwrap_or(index);
-                        Error::NotSpd { pivot: index, row }
+                        // faer's simplicial factorisation reports the pivot 1-based, the
+                        // supernodal one 0-based.
+                        let k = match symbolic.raw() {
+                            SymbolicCholeskyRaw::Simplicial(_) => index.saturating_sub(1),
+                            SymbolicCholeskyRaw::Supernodal(_) => index,
+                        }
+                        .min(n.saturating_sub(1));
+                        let row = symbolic.perm().map(|p| p.arrays().0[k]).unwrap_or(k);
+                        Error::NotSpd { pivot: k, row }
                     }
                 });
             }

@@ -49,6 +49,7 @@ pub mod casestudy;
 pub mod class;
 pub mod condense;
 pub mod error;
+pub mod ffi;
 pub mod generator;
 pub mod io;
 pub mod load;

@@ -267,9 +267,10 @@ fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
-/// Largest number of nodes switching at one point for which all neighbouring pieces are
-/// enumerated (4^k candidates).
-const MAX_ENUMERATED_NODES: usize = 7;
+/// Largest number of neighbouring pieces enumerated at one transition point (the product
+/// over the nodes at a class boundary of the number of classes that fit there; nodes at
+/// the vertex are handled by the directional problem instead).
+const MAX_CANDIDATE_PIECES: usize = 4096;
 
 impl Path {
     /// Binds a load to a problem. Computes the condensed load vectors (one back-solve per
@@ -548,9 +549,12 @@ impl Path {
         let enumerated: Vec<usize> = (0..nodes.len())
             .filter(|&k| !(use_directional && is_vertex[k]))
             .collect();
-        if enumerated.len() > MAX_ENUMERATED_NODES {
+        let combos = enumerated
+            .iter()
+            .fold(1usize, |acc, &k| acc.saturating_mul(options[k].len()));
+        if combos > MAX_CANDIDATE_PIECES {
             return Err(Error::Numerical(format!(
-                "{} nodes are at a class boundary at once at alpha = {:e} (more than {MAX_ENUMERATED_NODES} cannot be enumerated)",
+                "{} nodes are at a class boundary at once at alpha = {:e}: {combos} neighbouring pieces exceed the limit of {MAX_CANDIDATE_PIECES}",
                 enumerated.len(),
                 pt.alpha
             )));
@@ -889,7 +893,6 @@ impl Path {
     /// guards' Hermite interpolants certify free of double crossings, then Brent.
     fn exit_graph(&mut self, cur: &Cur) -> Result<Exit> {
         let m = 2 * self.problem.p();
-        let c_p = self.problem.p();
         let dir = if cur.t[m] > 0.0 { 1.0 } else { -1.0 };
         let (lo, hi) = self.window();
         let bound = if dir > 0.0 { hi } else { lo };
@@ -914,7 +917,6 @@ impl Path {
             let table = this.guard_table(&classes, &pt, Some(&t));
             Ok((pt, table))
         };
-        let _ = c_p;
         let (mut pa, mut ga) = eval(self, cur.alpha)?;
         let mut h = (span / 32.0).min((bound - cur.alpha).abs());
         let hmin = span * 1e-12;
@@ -923,7 +925,50 @@ impl Path {
             let tol = self.opts.zero_tol * scale;
             let at_bound = (bound - pa.alpha).abs() <= h;
             let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
-            let (pb, gb) = eval(self, b_alpha)?;
+            let (mut pb, mut gb) = eval(self, b_alpha)?;
+            // A guard the piece just entered (zero at a, increasing) that is negative at b:
+            // the step overshoots the piece's first stretch; shorten it.
+            let premature =
+                (0..gb.len()).any(|k| ga[k].1 <= tol && dir * ga[k].2 > 0.0 && gb[k].1 < -tol);
+            if premature && h > hmin {
+                h *= 0.5;
+                continue;
+            }
+            // A guard positive at both ends with a minimum inside (its derivative changes
+            // sign) may dip below zero and come back: locate the minimum (Brent on the
+            // derivative) and look at the guard there. A double crossing inside one step
+            // is never skipped, however close to tangent.
+            let mut cut: Option<f64> = None;
+            for k in 0..gb.len() {
+                if ga[k].1 > -tol && gb[k].1 >= -tol && dir * ga[k].2 < 0.0 && dir * gb[k].2 > 0.0 {
+                    let mut err = None;
+                    let smin =
+                        brent(
+                            pa.alpha,
+                            pb.alpha,
+                            dir * ga[k].2,
+                            dir * gb[k].2,
+                            |x| match eval(self, x) {
+                                Ok((_, tab)) => dir * tab[k].2,
+                                Err(e) => {
+                                    err = Some(e);
+                                    f64::NAN
+                                }
+                            },
+                        );
+                    if let Some(e) = err {
+                        return Err(e);
+                    }
+                    let (_, tab) = eval(self, smin)?;
+                    if tab[k].1 < -tol && cut.is_none_or(|c| dir * (smin - c) < 0.0) {
+                        cut = Some(smin);
+                    }
+                }
+            }
+            if let Some(smin) = cut {
+                (pb, gb) = eval(self, smin)?;
+            }
+            let at_bound = at_bound && cut.is_none();
             let delta = pb.alpha - pa.alpha;
             let crossing: Vec<usize> = (0..gb.len()).filter(|&k| gb[k].1 < -tol).collect();
             if crossing.is_empty() {

@@ -1,0 +1,126 @@
+#!/usr/bin/env bash
+# Builds and runs the C tests of fricont against target/release/libfricont.so (build it
+# first with `cargo build --release`; built here if missing). Installs libsuitesparse-dev
+# (CHOLMOD, for the reference check) with apt-get when it is missing. Runs the test
+# binaries under valgrind when valgrind is installed. Exits non-zero on any failure; the
+# last line is "N passed, M failed".
+#
+#   c-tests/run.sh            from the repository root or anywhere
+#   FRICONT_CASES=DIR         where the sample cases live (default ../shared/cases
+#                             relative to the repository root)
+set -uo pipefail
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$ROOT"
+CASES="${FRICONT_CASES:-$ROOT/../shared/cases}"
+OUT="$ROOT/target/c-tests"
+LIBDIR="$ROOT/target/release"
+mkdir -p "$OUT"
+passed=0
+failed=0
+pass() { passed=$((passed + 1)); echo "ok   $*"; }
+fail() { failed=$((failed + 1)); echo "FAIL $*"; }
+
+# --- prerequisites -------------------------------------------------------------------------
+if [ ! -f /usr/include/suitesparse/cholmod.h ]; then
+    echo "installing libsuitesparse-dev (CHOLMOD) ..."
+    SUDO=""
+    if [ "$(id -u)" != 0 ] && command -v sudo >/dev/null; then SUDO="sudo"; fi
+    $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libsuitesparse-dev >/dev/null
+    if [ ! -f /usr/include/suitesparse/cholmod.h ]; then
+        echo "cannot install libsuitesparse-dev"; echo "0 passed, 1 failed"; exit 1
+    fi
+fi
+if [ ! -f "$LIBDIR/libfricont.so" ]; then
+    cargo build --release || { echo "0 passed, 1 failed"; exit 1; }
+fi
+
+# --- build ---------------------------------------------------------------------------------
+WARN=(-Wall -Wextra -Wpedantic -Werror)
+LINK=(-L"$LIBDIR" -Wl,-rpath,"$LIBDIR" -lfricont)
+build() { # name, command...
+    local name=$1; shift
+    if "$@" 2>"$OUT/$name.build.log"; then pass "build $name"; else fail "build $name"; cat "$OUT/$name.build.log"; fi
+}
+C="cc -std=c99 -O1 -g -Iinclude -Ic-tests"
+build header_c $C "${WARN[@]}" c-tests/header_a.c c-tests/header_b.c -o "$OUT/header_c" "${LINK[@]}"
+build header_cpp c++ -std=c++17 -O1 -g -Iinclude "${WARN[@]}" c-tests/header_a.cpp c-tests/header_b.cpp -o "$OUT/header_cpp" "${LINK[@]}"
+build status $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/status.c c-tests/common.c -o "$OUT/status" "${LINK[@]}" -lm
+build paths $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/paths.c c-tests/common.c -o "$OUT/paths" "${LINK[@]}" -lm -lpthread
+build cholmod_ref $C -I/usr/include/suitesparse "${WARN[@]}" c-tests/cholmod_ref.c c-tests/common.c -o "$OUT/cholmod_ref" "${LINK[@]}" -lcholmod -lm
+build q1_rectangle $C "${WARN[@]}" examples-c/q1_rectangle.c -o "$OUT/q1_rectangle" "${LINK[@]}" -lm
+
+# --- run -----------------------------------------------------------------------------------
+# run LABEL BINARY ARGS...: the binary's own "N passed, M failed" line counts as one test.
+run() {
+    local label=$1; shift
+    local log="$OUT/$(echo "$label" | tr -c 'A-Za-z0-9_.-' '_').log"
+    if ! command -v "$1" >/dev/null; then fail "$label (not built)"; return; fi
+    "$@" >"$log" 2>&1
+    local rc=$?
+    local line
+    line=$(grep -E '[0-9]+ passed, [0-9]+ failed' "$log" | tail -1)
+    if [ $rc -eq 0 ] && [ -n "$line" ] && echo "$line" | grep -q ' 0 failed'; then
+        pass "$label: ${line#*: }"
+    else
+        fail "$label (exit $rc): ${line:-no result line}"; tail -30 "$log"
+    fi
+}
+SAMPLE="$CASES/sample-rect30"
+Q1="$OUT/q1case"
+mkdir -p "$Q1"
+run "header C99" "$OUT/header_c"
+run "header C++17" "$OUT/header_cpp"
+run "status codes" "$OUT/status"
+if "$OUT/q1_rectangle" --write "$Q1" >"$OUT/q1_rectangle.txt" 2>&1 && grep -q "stick  -> slip+" "$OUT/q1_rectangle.txt"; then
+    pass "examples-c/q1_rectangle prints a transition table"
+else
+    fail "examples-c/q1_rectangle"; cat "$OUT/q1_rectangle.txt"
+fi
+run "CHOLMOD reference: Q1 example" "$OUT/cholmod_ref" "$Q1"
+run "CHOLMOD reference: Q1 example, F = 1.2, 1-based, upper" "$OUT/cholmod_ref" "$Q1" --F 1.2 --base 1 --storage upper
+if [ -f "$SAMPLE/meta.json" ]; then
+    run "CHOLMOD reference: sample" "$OUT/cholmod_ref" "$SAMPLE" --events "$OUT/sample-events.txt"
+    run "CHOLMOD reference: sample, 1-based, lower" "$OUT/cholmod_ref" "$SAMPLE" --base 1 --storage lower
+    run "CHOLMOD reference: sample, upper, r = 10" "$OUT/cholmod_ref" "$SAMPLE" --storage upper --r 10
+    run "CHOLMOD reference: sample, F = 0.9" "$OUT/cholmod_ref" "$SAMPLE" --F 0.9
+    run "CHOLMOD reference: sample, F = 0" "$OUT/cholmod_ref" "$SAMPLE" --F 0
+    run "loads and threads: sample" "$OUT/paths" "$SAMPLE"
+    # the same events as the CLI (when the CLI can trace)
+    CLI="$LIBDIR/fricont"
+    if [ -x "$CLI" ] && "$CLI" trace "$SAMPLE" --json "$OUT/sample-cli.json" >/dev/null 2>&1 && command -v python3 >/dev/null; then
+        if python3 - "$OUT/sample-cli.json" "$OUT/sample-events.txt" <<'PY'
+import json, sys
+cli = json.load(open(sys.argv[1]))["events"]
+c = [l.split() for l in open(sys.argv[2]) if l.strip()]
+assert len(cli) == len(c), f"{len(cli)} CLI events, {len(c)} from C"
+for e, l in zip(cli, c):
+    a = float(l[0])
+    assert abs(e["alpha"] - a) <= 1e-12 * max(1.0, abs(a)), (e, l)
+    assert (e["node"], e["from"], e["to"]) == (int(l[1]), l[2], l[3]), (e, l)
+PY
+        then pass "the C API gives the CLI's events on the sample"; else fail "C API events differ from the CLI's"; fi
+    else
+        echo "skip the CLI comparison (no working target/release/fricont trace or no python3)"
+    fi
+else
+    fail "sample case not found at $SAMPLE (set FRICONT_CASES)"
+fi
+run "loads and threads: Q1 example" "$OUT/paths" "$Q1"
+
+# --- valgrind ------------------------------------------------------------------------------
+if command -v valgrind >/dev/null; then
+    VG=(valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite)
+    run "valgrind header C99" "${VG[@]}" "$OUT/header_c"
+    run "valgrind status codes" "${VG[@]}" "$OUT/status"
+    run "valgrind CHOLMOD reference: Q1 example" "${VG[@]}" "$OUT/cholmod_ref" "$Q1"
+    run "valgrind loads and threads: Q1 example" "${VG[@]}" "$OUT/paths" "$Q1"
+    if [ -f "$SAMPLE/meta.json" ]; then
+        run "valgrind CHOLMOD reference: sample" "${VG[@]}" "$OUT/cholmod_ref" "$SAMPLE"
+    fi
+else
+    echo "skip valgrind (not installed)"
+fi
+
+echo "c-tests: $passed passed, $failed failed"
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ]

@@ -1,0 +1,320 @@
+// Tests of the C++ wrapper (include/fricont.hpp) on a real problem.
+//
+// Usage: test_wrapper CASE_DIR REFERENCE_EVENTS
+// REFERENCE_EVENTS is the output of tests-install/trace_case (the C interface used
+// directly) on the same case. Prints "ok NAME" or "FAIL NAME: why" per check and exits
+// with the number of failures.
+#include <fricont.hpp>
+
+#include "case.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <type_traits>
+#include <vector>
+
+static_assert(!std::is_copy_constructible<fricont::Problem>::value, "Problem is move-only");
+static_assert(!std::is_copy_assignable<fricont::Problem>::value, "Problem is move-only");
+static_assert(std::is_nothrow_move_constructible<fricont::Problem>::value, "noexcept move");
+static_assert(std::is_nothrow_move_assignable<fricont::Problem>::value, "noexcept move");
+static_assert(!std::is_copy_constructible<fricont::Path>::value, "Path is move-only");
+static_assert(std::is_nothrow_move_constructible<fricont::Path>::value, "noexcept move");
+static_assert(std::is_nothrow_move_assignable<fricont::Path>::value, "noexcept move");
+
+namespace {
+
+int failures = 0;
+
+void report(const std::string &name, bool ok, const std::string &why = "") {
+    if (ok) std::cout << "ok " << name << "\n";
+    else {
+        std::cout << "FAIL " << name << ": " << why << "\n";
+        failures++;
+    }
+}
+
+struct RefEvent {
+    long index, transition, node;
+    double alpha;
+    std::string from, to;
+    int fold, bif;
+};
+
+std::vector<RefEvent> read_reference(const std::string &path) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error("cannot open " + path);
+    std::vector<RefEvent> out;
+    std::string line;
+    while (std::getline(in, line)) {
+        std::istringstream ss(line);
+        std::string tag;
+        ss >> tag;
+        if (tag != "event") continue;
+        RefEvent e;
+        ss >> e.index >> e.transition >> e.alpha >> e.node >> e.from >> e.to >> e.fold >> e.bif;
+        out.push_back(e);
+    }
+    return out;
+}
+
+// Compares events with the reference after mapping the reference α through `map`;
+// returns an empty string or the first difference.
+template <class Map>
+std::string compare(const std::vector<fricont::Event> &got, const std::vector<RefEvent> &ref,
+                    double rtol, Map map, std::size_t count) {
+    if (got.size() < count || ref.size() < count)
+        return "event counts " + std::to_string(got.size()) + " vs " + std::to_string(ref.size());
+    for (std::size_t k = 0; k < count; k++) {
+        const auto &g = got[k];
+        const auto &r = ref[k];
+        double want = map(r.alpha);
+        std::ostringstream why;
+        why.precision(17);
+        if (g.index + 1 != r.index || g.transition + 1 != r.transition || g.node + 1 != r.node ||
+            fricont::name(g.from) != r.from || fricont::name(g.to) != r.to ||
+            int(g.fold) != r.fold || int(g.bifurcation) != r.bif)
+            why << "event " << k + 1 << ": node " << g.node + 1 << " " << fricont::name(g.from)
+                << "->" << fricont::name(g.to) << " vs node " << r.node << " " << r.from
+                << "->" << r.to;
+        else if (std::fabs(g.alpha - want) > rtol * std::max(1.0, std::fabs(want)))
+            why << "event " << k + 1 << ": alpha " << g.alpha << " vs " << want;
+        if (!why.str().empty()) return why.str();
+    }
+    return "";
+}
+
+// An independent check of a solution (u, λν, λt, classes) at load f: equilibrium
+// A u = f + Nᵀλν + Tᵀλt, and for each node the conditions of its class (SPEC §1, §3),
+// with tolerances relative to the data's scale.
+std::string check_solution(const casefile::Case &c, const fricont::State &s,
+                           const std::vector<double> &f) {
+    const std::size_t n = c.f0.size(), p = c.gap.size();
+    std::vector<double> au = c.a.apply(s.u), ntl = c.n.apply_t(s.lambda_n),
+                        ttl = c.t.apply_t(s.lambda_t);
+    double fscale = 0, res = 0;
+    for (std::size_t i = 0; i < n; i++) {
+        fscale = std::max({fscale, std::fabs(f[i]), std::fabs(au[i])});
+        res = std::max(res, std::fabs(au[i] - f[i] - ntl[i] - ttl[i]));
+    }
+    if (res > 1e-9 * fscale) return "equilibrium residual " + std::to_string(res / fscale);
+    std::vector<double> nu = c.n.apply(s.u), tu = c.t.apply(s.u);
+    double lscale = 0, lam = 0;
+    for (double x : s.u) lscale = std::max(lscale, std::fabs(x));
+    for (std::size_t i = 0; i < p; i++)
+        lam = std::max({lam, std::fabs(s.lambda_n[i]), std::fabs(s.lambda_t[i])});
+    const double tl = 1e-9 * lscale, tf = 1e-9 * lam;
+    for (std::size_t i = 0; i < p; i++) {
+        double dn = nu[i] - c.gap[i], dt = tu[i], ln = s.lambda_n[i], lt = s.lambda_t[i];
+        double fr = c.friction[i];
+        bool ok = ln <= tf && dn <= tl && std::fabs(lt) <= -fr * ln + tf;
+        switch (s.classes[i]) {
+        case fricont::Class::Open: ok = ok && std::fabs(ln) <= tf && std::fabs(lt) <= tf; break;
+        case fricont::Class::Stick: ok = ok && std::fabs(dn) <= tl && std::fabs(dt) <= tl; break;
+        case fricont::Class::SlipPlus:
+            ok = ok && std::fabs(dn) <= tl && std::fabs(lt - fr * ln) <= tf && dt >= -tl;
+            break;
+        case fricont::Class::SlipMinus:
+            ok = ok && std::fabs(dn) <= tl && std::fabs(lt + fr * ln) <= tf && dt <= tl;
+            break;
+        }
+        if (!ok)
+            return "node " + std::to_string(i + 1) + " violates " + fricont::name(s.classes[i]);
+    }
+    return "";
+}
+
+fricont::Problem make_problem(const casefile::Case &c) {
+    fricont::CsrRef a(c.a.nrows, c.a.ncols, c.a.row_ptr, c.a.col_idx, c.a.values);
+    fricont::CsrRef n(c.n.nrows, c.n.ncols, c.n.row_ptr, c.n.col_idx, c.n.values);
+    fricont::CsrRef t(c.t.nrows, c.t.ncols, c.t.row_ptr, c.t.col_idx, c.t.values);
+    fricont::Problem prob(a, c.a.symmetric ? fricont::Storage::Lower : fricont::Storage::Full,
+                          n, t);
+    prob.set_friction(c.friction);
+    prob.set_gap(c.gap);
+    return prob;
+}
+
+}  // namespace
+
+int main(int argc, char **argv) {
+    if (argc != 3) {
+        std::cerr << "usage: test_wrapper CASE_DIR REFERENCE_EVENTS\n";
+        return 2;
+    }
+    const casefile::Case c = casefile::read_case(argv[1]);
+    const std::vector<RefEvent> ref = read_reference(argv[2]);
+    const auto same = [](double a) { return a; };
+
+    report("version matches header",
+           fricont::version() == std::to_string(FRICONT_VERSION_MAJOR) + "." +
+                                     std::to_string(FRICONT_VERSION_MINOR) + "." +
+                                     std::to_string(FRICONT_VERSION_PATCH));
+
+    // 1. The affine load traced through the wrapper gives the C interface's events.
+    fricont::Problem prob = make_problem(c);
+    report("problem dims", prob.n() == c.a.nrows && prob.p() == c.n.nrows);
+    fricont::Path path = fricont::Path::affine(prob, c.f0, c.f1);
+    path.set_window(c.alpha_start, c.alpha_end);
+    path.start(c.alpha_start);
+    fricont::EndReason why = path.run();
+    std::vector<fricont::Event> ev = path.events();
+    report("affine: ends at the window", why == fricont::EndReason::Window, fricont::name(why));
+    std::string diff = compare(ev, ref, 0.0, same, ref.size());
+    report("affine: events equal the C reference", diff.empty() && ev.size() == ref.size(), diff);
+    report("affine: pieces = events + 1", path.pieces().size() == ev.size() + 1);
+
+    // 2. Solutions between events satisfy the equations (checked here, independently).
+    if (ev.size() >= 2) {
+        double alpha = 0.5 * (ev[0].alpha + ev[1].alpha);
+        std::vector<fricont::Solution> sols = path.solutions_at(alpha);
+        std::vector<double> f(c.f0.size());
+        for (std::size_t i = 0; i < f.size(); i++) f[i] = c.f0[i] + alpha * c.f1[i];
+        report("solutions_at: one solution", sols.size() == 1);
+        if (!sols.empty()) {
+            std::string bad = check_solution(c, sols[0].state, f);
+            report("solutions_at: equilibrium and class conditions", bad.empty(), bad);
+            report("solutions_at: lies on piece 1", sols[0].piece == 1);
+        }
+        fricont::State at = path.event_state(0);
+        for (std::size_t i = 0; i < f.size(); i++) f[i] = c.f0[i] + at.alpha * c.f1[i];
+        std::string bad = check_solution(c, at, f);
+        report("event_state: equilibrium and class conditions", bad.empty(), bad);
+    }
+
+    // 3. Moves transfer ownership; the moved-to path keeps working.
+    {
+        fricont::Path moved = std::move(path);
+        report("move: moved-from holds no handle", path.get() == nullptr && moved.get() != nullptr);
+        fricont::Path other = fricont::Path::affine(prob, c.f0, c.f1);
+        other = std::move(moved);  // frees other's first handle
+        report("move: assigned path keeps its events", other.events().size() == ev.size());
+        fricont::Problem p2 = std::move(prob);
+        report("move: problem moved", prob.get() == nullptr && p2.get() != nullptr);
+        prob = std::move(p2);
+    }
+
+    // 4. A general load f(α) = f0 + sinh(α) f1 passes the same loads: its events are at
+    //    asinh of the affine ones.
+    {
+        auto load = [&c](double a, double *out, std::size_t n) {
+            double s = std::sinh(a);
+            for (std::size_t i = 0; i < n; i++) out[i] = c.f0[i] + s * c.f1[i];
+        };
+        auto dload = [&c](double a, double *out, std::size_t n) {
+            double s = std::cosh(a);
+            for (std::size_t i = 0; i < n; i++) out[i] = s * c.f1[i];
+        };
+        fricont::Path g = fricont::Path::general(prob, load, dload);
+        g.set_window(std::asinh(c.alpha_start), std::asinh(c.alpha_end));
+        g.start(std::asinh(c.alpha_start));
+        fricont::EndReason r = g.run();
+        std::vector<fricont::Event> gev = g.events();
+        std::string d = compare(gev, ref, 1e-9, [](double a) { return std::asinh(a); }, ref.size());
+        report("general load: ends at the window", r == fricont::EndReason::Window,
+               fricont::name(r));
+        report("general load: events at asinh(reference)",
+               d.empty() && gev.size() == ref.size(), d);
+    }
+
+    // 5. An exception thrown by a load callback comes back out of the wrapper call (it
+    //    never crosses the library) and the path ends, keeping what it traced.
+    if (ev.size() >= 3) {
+        const double stop = 0.5 * (ev[1].alpha + ev[2].alpha);
+        auto load = [&c, stop](double a, double *out, std::size_t n) {
+            if (a > stop) throw std::domain_error("load not defined past the stop");
+            for (std::size_t i = 0; i < n; i++) out[i] = c.f0[i] + a * c.f1[i];
+        };
+        fricont::Path g = fricont::Path::general(prob, load);
+        g.set_window(c.alpha_start, c.alpha_end);
+        g.start(c.alpha_start);
+        std::string caught;
+        try {
+            g.run();
+        } catch (const std::domain_error &e) {
+            caught = e.what();
+        }
+        report("callback exception rethrown", caught == "load not defined past the stop", caught);
+        report("callback exception: path failed", g.end_reason() == fricont::EndReason::Failed);
+        // The library may evaluate the load ahead of the point it reached (step control),
+        // so only "a prefix of the reference events, none past the stop" is certain.
+        std::vector<fricont::Event> kept = g.events();
+        std::string d = compare(kept, ref, 1e-9, same, kept.size());
+        report("callback exception: events kept are a prefix", d.empty() && kept.size() <= 2, d);
+        bool again = false;
+        try {
+            g.step();
+            again = true;
+        } catch (...) {
+        }
+        report("callback exception: later step returns End", again);
+    }
+
+    // 6. Distinct paths on one problem traced from two threads at once give the same
+    //    events (the handles share no mutable state).
+    {
+        std::vector<fricont::Event> got[2];
+        std::string failure[2];
+        auto work = [&](int k) {
+            try {
+                fricont::Path t = fricont::Path::affine(prob, c.f0, c.f1);
+                t.set_window(c.alpha_start, c.alpha_end);
+                t.start(c.alpha_start);
+                t.run();
+                got[k] = t.events();
+            } catch (const std::exception &e) {
+                failure[k] = e.what();
+            }
+        };
+        std::thread t0(work, 0), t1(work, 1);
+        t0.join();
+        t1.join();
+        std::string d0 = compare(got[0], ref, 0.0, same, ref.size());
+        std::string d1 = compare(got[1], ref, 0.0, same, ref.size());
+        report("two threads: both paths give the reference events",
+               failure[0].empty() && failure[1].empty() && d0.empty() && d1.empty() &&
+                   got[0].size() == ref.size() && got[1].size() == ref.size(),
+               failure[0] + failure[1] + d0 + d1);
+    }
+
+    // 7. Errors of the library are exceptions with the status and the message.
+    {
+        std::vector<int64_t> ptr{0, 1, 2}, idx{0, 7};
+        std::vector<double> val{1.0, 1.0};
+        fricont::CsrRef bad(2, 2, ptr, idx, val);
+        int32_t status = 0;
+        std::string msg;
+        try {
+            fricont::Problem p(bad, fricont::Storage::Full, bad, bad);
+        } catch (const fricont::Error &e) {
+            status = e.status();
+            msg = e.what();
+        }
+        report("bad CSR throws FRICONT_ERR_CSR", status == FRICONT_ERR_CSR, std::to_string(status));
+        report("bad CSR message names the column", msg.find('7') != std::string::npos, msg);
+        fricont::Path q = fricont::Path::affine(prob, c.f0, c.f1);
+        status = 0;
+        try {
+            q.start(0.0);  // no window set
+        } catch (const fricont::Error &e) {
+            status = e.status();
+        }
+        report("start without window throws FRICONT_ERR_ORDER", status == FRICONT_ERR_ORDER);
+        status = 0;
+        try {
+            prob.set_friction(-1.0);
+        } catch (const fricont::Error &e) {
+            status = e.status();
+        }
+        report("negative friction throws FRICONT_ERR_RANGE", status == FRICONT_ERR_RANGE);
+    }
+
+    std::cout << "cpp-tests: " << failures << " failed check(s)\n";
+    return failures;
+}

@@ -1,0 +1,269 @@
+!> Tests of the fricont Fortran module beyond the traced events (which run.sh compares
+!> with the C interface): the err argument, 0- and 1-based CSR with 32- and 64-bit
+!> indices, a failing Fortran callback, the basis load, solutions_at checked against the
+!> equations evaluated here. Prints "ok NAME" / "FAIL NAME: why"; exits 1 on a failure.
+module api_callbacks
+    use, intrinsic :: iso_c_binding, only: c_double, c_int64_t, c_int32_t, c_ptr, &
+        c_f_pointer
+    use, intrinsic :: iso_fortran_env, only: real64
+    implicit none
+    type :: stop_load
+        real(real64), allocatable :: f0(:), f1(:)
+        real(real64) :: stop_at = 0
+    end type stop_load
+contains
+    !> f0 + alpha f1, but refuses (code 7) past stop_at.
+    function refusing_load(alpha, f, n, user_data) bind(C) result(code)
+        real(c_double), value :: alpha
+        integer(c_int64_t), value :: n
+        real(c_double), intent(out) :: f(n)
+        type(c_ptr), value :: user_data
+        integer(c_int32_t) :: code
+        type(stop_load), pointer :: d
+        call c_f_pointer(user_data, d)
+        f = d%f0 + alpha*d%f1
+        code = 0
+        if (alpha > d%stop_at) code = 7
+    end function refusing_load
+
+    !> phi = (1, sinh(s)), phi' = (0, cosh(s)).
+    function sinh_weights(s, phi, dphi, k, user_data) bind(C) result(code)
+        real(c_double), value :: s
+        integer(c_int64_t), value :: k
+        real(c_double), intent(out) :: phi(k), dphi(k)
+        type(c_ptr), value :: user_data
+        integer(c_int32_t) :: code
+        phi = [1.0_real64, sinh(s)]
+        dphi = [0.0_real64, cosh(s)]
+        code = 0
+        if (k /= 2) code = 1
+    end function sinh_weights
+end module api_callbacks
+
+program test_api
+    use, intrinsic :: iso_c_binding, only: c_loc
+    use, intrinsic :: iso_fortran_env, only: real64, int64
+    use fricont
+    use case_reader, only: case_data, csr_matrix, read_case
+    use api_callbacks
+    implicit none
+    character(len=4096) :: dir
+    type(case_data) :: c
+    integer :: failures = 0
+
+    call get_command_argument(1, dir)
+    call read_case(trim(dir), c)
+    call run_all(c)
+    write (*, '(a,i0,a)') 'fortran test_api: ', failures, ' failed check(s)'
+    if (failures > 0) error stop 1
+
+contains
+
+    subroutine check(name, cond, why)
+        character(len=*), intent(in) :: name
+        logical, intent(in) :: cond
+        character(len=*), intent(in), optional :: why
+        if (cond) then
+            write (*, '(2a)') 'ok ', name
+        else
+            failures = failures + 1
+            if (present(why)) then
+                write (*, '(4a)') 'FAIL ', name, ': ', why
+            else
+                write (*, '(2a)') 'FAIL ', name
+            end if
+        end if
+    end subroutine check
+
+    function matvec(m, x) result(y)
+        type(csr_matrix), intent(in) :: m
+        real(real64), intent(in) :: x(:)
+        real(real64), allocatable :: y(:)
+        integer :: i, k
+        allocate (y(m%nrows), source=0.0_real64)
+        do i = 1, m%nrows
+            do k = m%row_ptr(i), m%row_ptr(i + 1) - 1
+                y(i) = y(i) + m%val(k)*x(m%col(k))
+            end do
+        end do
+    end function matvec
+
+    function matvec_t(m, x) result(y)
+        type(csr_matrix), intent(in) :: m
+        real(real64), intent(in) :: x(:)
+        real(real64), allocatable :: y(:)
+        integer :: i, k
+        allocate (y(m%ncols), source=0.0_real64)
+        do i = 1, m%nrows
+            do k = m%row_ptr(i), m%row_ptr(i + 1) - 1
+                y(m%col(k)) = y(m%col(k)) + m%val(k)*x(i)
+            end do
+        end do
+    end function matvec_t
+
+    subroutine make_problem(c, prob)
+        type(case_data), intent(in) :: c
+        type(fricont_problem), intent(inout) :: prob
+        call prob%create(c%a%row_ptr, c%a%col, c%a%val, c%n%row_ptr, c%n%col, c%n%val, &
+                         c%t%row_ptr, c%t%col, c%t%val)
+        call prob%set_friction(c%friction)
+        call prob%set_gap(c%gap)
+    end subroutine make_problem
+
+    subroutine run_all(c)
+        type(case_data), intent(in) :: c
+        type(fricont_problem) :: prob, prob0, bad
+        type(fricont_path) :: path, refusing, basis
+        type(fricont_error) :: err
+        type(fricont_event), allocatable :: ev(:), evb(:)
+        type(fricont_state) :: s
+        type(fricont_piece) :: pc1, pc2
+        integer(int64) :: n, p
+        character(len=:), allocatable :: version
+        type(stop_load), target :: sl
+        integer :: count, piece, reason, k, i
+        logical :: continuum, same
+        real(real64) :: alpha, scale, tol
+        real(real64), allocatable :: f(:), r(:), dn(:), dt(:)
+        character(len=32) :: buf
+
+        version = fricont_version()
+        call check('version has three numbers', len(version) >= 5 .and. &
+                   verify(version, '0123456789.') == 0, version)
+
+        ! Bad CSR: a column index past n, reported through err, not a stop.
+        block
+            integer :: ptr(3), col(2)
+            real(real64) :: val(2)
+            ptr = [1, 2, 3]
+            col = [1, 9]
+            val = [1.0_real64, 1.0_real64]
+            call bad%create(ptr, col, val, ptr, col, val, ptr, col, val, err=err)
+            call check('bad CSR: status FRICONT_ERR_CSR', err%status == FRICONT_ERR_CSR, &
+                       err%message)
+            call check('bad CSR: message names the column', index(err%message, '9') > 0, &
+                       err%message)
+            call check('bad CSR: no handle', .not. bad%is_created())
+        end block
+
+        ! The sample through 1-based default-integer CSR (as read).
+        call make_problem(c, prob)
+        n = prob%n()
+        p = prob%p()
+        call check('dims', n == c%a%nrows .and. p == c%n%nrows)
+        call check('r > 0', prob%r() > 0)
+
+        ! The same data 0-based with int64 indices gives the same path.
+        call prob0%create(int(c%a%row_ptr - 1, int64), int(c%a%col - 1, int64), c%a%val, &
+                          int(c%n%row_ptr - 1, int64), int(c%n%col - 1, int64), c%n%val, &
+                          int(c%t%row_ptr - 1, int64), int(c%t%col - 1, int64), c%t%val, &
+                          index_base=0, err=err)
+        call check('0-based int64 CSR accepted', err%ok(), err%message)
+        call prob0%set_friction(c%friction)
+        call prob0%set_gap(c%gap)
+
+        call path%create_affine(prob, c%f0, c%f1)
+        call path%set_window(c%alpha_start, c%alpha_end)
+        call path%start(c%alpha_start)
+        call path%run(reason)
+        ev = path%events()
+        call check('affine: ends at the window', reason == FRICONT_END_WINDOW)
+        call check('affine: events found', size(ev) >= 2)
+
+        block
+            type(fricont_path) :: p0
+            type(fricont_event), allocatable :: e0(:)
+            call p0%create_affine(prob0, c%f0, c%f1)
+            call p0%set_window(c%alpha_start, c%alpha_end)
+            call p0%start(c%alpha_start)
+            call p0%run()
+            e0 = p0%events()
+            same = size(e0) == size(ev)
+            if (same) same = all(e0%alpha == ev%alpha) .and. all(e0%node == ev%node)
+            call check('0-based int64 CSR: same events', same)
+        end block
+
+        ! Pieces: one more than the events, contiguous in alpha.
+        call check('pieces = events + 1', path%piece_count() == size(ev) + 1)
+        same = .true.
+        do k = 1, size(ev)
+            pc1 = path%piece(k)
+            pc2 = path%piece(k + 1)
+            same = same .and. pc1%alpha_to == ev(k)%alpha .and. pc2%alpha_from == ev(k)%alpha
+        end do
+        call check('pieces meet at the events', same)
+
+        ! solutions_at between events 1 and 2: checked against the equations here.
+        if (size(ev) >= 2) then
+            alpha = 0.5_real64*(ev(1)%alpha + ev(2)%alpha)
+            call path%solutions_at(alpha, count)
+            call check('solutions_at: one solution', count == 1)
+            call path%solution(1, s, piece, continuum)
+            call check('solutions_at: on piece 2, not a continuum', piece == 2 .and. &
+                       .not. continuum)
+            f = c%f0 + alpha*c%f1
+            r = matvec(c%a, s%u) - f - matvec_t(c%n, s%lambda_n) - matvec_t(c%t, s%lambda_t)
+            scale = maxval(abs(f))
+            write (buf, '(es10.3)') maxval(abs(r))/scale
+            call check('solutions_at: equilibrium A u = f + N''ln + T''lt', &
+                       maxval(abs(r)) <= 1e-9_real64*scale, buf)
+            dn = matvec(c%n, s%u) - c%gap
+            dt = matvec(c%t, s%u)
+            tol = 1e-9_real64*maxval(abs(s%u))
+            same = .true.
+            do i = 1, size(dn)
+                select case (s%classes(i))
+                case (FRICONT_STICK)
+                    same = same .and. abs(dn(i)) <= tol .and. abs(dt(i)) <= tol
+                case (FRICONT_OPEN)
+                    same = same .and. dn(i) <= tol .and. s%lambda_n(i) == 0
+                case (FRICONT_SLIP_PLUS, FRICONT_SLIP_MINUS)
+                    same = same .and. abs(dn(i)) <= tol
+                end select
+            end do
+            call check('solutions_at: contact conditions of each class', same)
+        end if
+
+        ! A Fortran callback that refuses past a point: err, code, end reason.
+        if (size(ev) >= 3) then
+            sl%f0 = c%f0
+            sl%f1 = c%f1
+            sl%stop_at = 0.5_real64*(ev(2)%alpha + ev(3)%alpha)
+            call refusing%create_general(prob, refusing_load, user_data=c_loc(sl))
+            call refusing%set_window(c%alpha_start, c%alpha_end)
+            call refusing%start(c%alpha_start)
+            call refusing%run(reason, err=err)
+            call check('callback code 7: FRICONT_ERR_CALLBACK', &
+                       err%status == FRICONT_ERR_CALLBACK, err%message)
+            call check('callback code 7: kept by the path', refusing%callback_code() == 7)
+            call check('callback code 7: path failed', reason == FRICONT_END_FAILED)
+            call check('callback code 7: stepping again ends', &
+                       refusing%end_reason() == FRICONT_END_FAILED)
+        end if
+
+        ! The basis load f = f0 + sinh(s) f1 with weights from a Fortran callback.
+        call basis%create_basis(prob, reshape([c%f0, c%f1], [size(c%f0), 2]), sinh_weights)
+        call basis%set_window(asinh(c%alpha_start), asinh(c%alpha_end))
+        call basis%start(asinh(c%alpha_start))
+        call basis%run(reason)
+        evb = basis%events()
+        same = size(evb) == size(ev)
+        if (same) same = all(evb%node == ev%node) .and. &
+                         all(abs(sinh(evb%alpha) - ev%alpha) <= &
+                             1e-9_real64*max(1.0_real64, abs(ev%alpha)))
+        call check('basis load: events at asinh of the affine ones', same)
+
+        ! Misuse through err: starting outside the window, a wrong guess length.
+        call path%start(c%alpha_end + 10, err=err)
+        call check('start outside the window: FRICONT_ERR_RANGE', err%status == FRICONT_ERR_RANGE, &
+                   err%message)
+        call path%start(c%alpha_start, guess=[1.0_real64, 2.0_real64], err=err)
+        call check('guess of the wrong length: FRICONT_ERR_LENGTH', &
+                   err%status == FRICONT_ERR_LENGTH, err%message)
+        call prob%set_friction(-1.0_real64, err=err)
+        call check('negative friction: FRICONT_ERR_RANGE', err%status == FRICONT_ERR_RANGE)
+        call check('status name', &
+                   index(fricont_status_name(FRICONT_ERR_CSR), 'FRICONT_ERR_CSR') == 1)
+    end subroutine run_all
+
+end program test_api

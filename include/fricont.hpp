@@ -1,0 +1,521 @@
+// fricont.hpp: a header-only C++17 wrapper over the C interface (fricont.h).
+//
+// * `fricont::Problem` and `fricont::Path` own their handles: the destructor frees them;
+//   they are move-only (no copies, a moved-from object holds no handle).
+// * Every failing C call becomes a `fricont::Error` (status code and the library's
+//   message), thrown here, on the C++ side, after the C call has returned.
+// * A load given as a C++ callable is called through a `noexcept` trampoline: an
+//   exception it throws is caught before it could reach the library, the callback returns
+//   a nonzero code (the library ends the step cleanly), and the wrapper rethrows the
+//   original exception once the C call has returned.
+// * Indices are those of the C interface: 0-based nodes, events and pieces; CSR input
+//   takes an `index_base` of 0 or 1.
+//
+// Link as for the C interface (`pkg-config --cflags --libs fricont`, or CMake
+// `find_package(fricont)` and `target_link_libraries(app fricont::fricont)`).
+#ifndef FRICONT_HPP
+#define FRICONT_HPP
+
+#include <fricont.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <functional>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace fricont {
+
+/// A failed call: `status()` is the `fricont_status` code (negative), `what()` the
+/// library's message ("FRICONT_ERR_CSR: A (CSR): row 17 ...").
+class Error : public std::runtime_error {
+public:
+    Error(int32_t status, const std::string &message)
+        : std::runtime_error(message), status_(status) {}
+    /// The negative `fricont_status` code of the failing call.
+    int32_t status() const noexcept { return status_; }
+
+private:
+    int32_t status_;
+};
+
+/// Class of a contact node (SPEC §3).
+enum class Class : int32_t {
+    Open = FRICONT_OPEN,
+    Stick = FRICONT_STICK,
+    SlipPlus = FRICONT_SLIP_PLUS,
+    SlipMinus = FRICONT_SLIP_MINUS,
+};
+
+/// "open", "stick", "slip+" or "slip-".
+inline std::string name(Class c) { return fricont_class_name(static_cast<int32_t>(c)); }
+
+/// Which triangle of A is passed.
+enum class Storage : int32_t {
+    Full = FRICONT_STORAGE_FULL,
+    Lower = FRICONT_STORAGE_LOWER,
+    Upper = FRICONT_STORAGE_UPPER,
+};
+
+/// What a step found (the positive outcomes of `fricont_path_step`).
+enum class Outcome : int32_t {
+    Transition = FRICONT_TRANSITION,
+    Fold = FRICONT_FOLD,
+    Bifurcation = FRICONT_BIFURCATION,
+    End = FRICONT_END,
+};
+
+/// Why a path ended.
+enum class EndReason : int32_t {
+    None = FRICONT_END_NONE,
+    Window = FRICONT_END_WINDOW,
+    MaxSteps = FRICONT_END_MAX_STEPS,
+    ClosedLoop = FRICONT_END_CLOSED_LOOP,
+    Bifurcation = FRICONT_END_BIFURCATION,
+    Failed = FRICONT_END_FAILED,
+};
+
+/// "none", "window", "max_steps", "closed_loop", "bifurcation" or "failed".
+inline std::string name(EndReason r) {
+    switch (r) {
+    case EndReason::None: return "none";
+    case EndReason::Window: return "window";
+    case EndReason::MaxSteps: return "max_steps";
+    case EndReason::ClosedLoop: return "closed_loop";
+    case EndReason::Bifurcation: return "bifurcation";
+    case EndReason::Failed: return "failed";
+    }
+    return "unknown";
+}
+
+/// The library's run-time version "MAJOR.MINOR.PATCH".
+inline std::string version() { return fricont_version(); }
+
+/// A borrowed CSR matrix: the caller's arrays, read (and copied by the library) only
+/// during the call that receives it.
+struct CsrRef {
+    int64_t nrows = 0;
+    int64_t ncols = 0;
+    const int64_t *row_ptr = nullptr;  ///< nrows + 1 entries
+    const int64_t *col_idx = nullptr;  ///< nnz entries
+    const double *values = nullptr;    ///< nnz entries
+    int64_t index_base = 0;            ///< 0 or 1
+
+    CsrRef() = default;
+    /// From vectors (nnz = col_idx.size()).
+    CsrRef(int64_t rows, int64_t cols, const std::vector<int64_t> &ptr,
+           const std::vector<int64_t> &idx, const std::vector<double> &vals, int64_t base = 0)
+        : nrows(rows), ncols(cols), row_ptr(ptr.data()), col_idx(idx.data()),
+          values(vals.data()), index_base(base), nnz_(static_cast<int64_t>(idx.size())) {}
+    /// From raw arrays of `nnz` entries.
+    CsrRef(int64_t rows, int64_t cols, int64_t nnz, const int64_t *ptr, const int64_t *idx,
+           const double *vals, int64_t base = 0)
+        : nrows(rows), ncols(cols), row_ptr(ptr), col_idx(idx), values(vals),
+          index_base(base), nnz_(nnz) {}
+
+    /// The C view.
+    fricont_csr c() const {
+        return fricont_csr{nrows, ncols, nnz_, row_ptr, col_idx, values, index_base};
+    }
+
+private:
+    int64_t nnz_ = 0;
+};
+
+/// One node changing class (C++ copy of `fricont_event`; 0-based index, node).
+struct Event {
+    int64_t index = 0;
+    int64_t transition = 0;
+    double alpha = 0.0;
+    int64_t node = 0;
+    Class from = Class::Open;
+    Class to = Class::Open;
+    bool fold = false;
+    bool bifurcation = false;
+    double residual = 0.0;
+};
+
+/// A point of the solution curve (u: n values; lambda_n, lambda_t, classes: p values).
+struct State {
+    double alpha = 0.0;
+    double residual = 0.0;
+    std::vector<double> u;
+    std::vector<double> lambda_n;
+    std::vector<double> lambda_t;
+    std::vector<Class> classes;
+};
+
+/// A traced smooth piece.
+struct Piece {
+    double alpha_from = 0.0;
+    double alpha_to = 0.0;
+    int32_t direction = 0;
+    int32_t orientation = 0;
+    int32_t det_sign = 0;
+    std::vector<Class> classes;
+};
+
+/// A candidate continuation at a bifurcation.
+struct Branch {
+    int32_t direction = 0;
+    bool orientation_preserving = false;
+    std::vector<Class> classes;
+};
+
+/// A solution at a given α (see `Path::solutions_at`).
+struct Solution {
+    int64_t piece = 0;
+    bool continuum = false;
+    State state;
+};
+
+namespace detail {
+
+inline std::string last_error() {
+    std::string s(fricont_last_error_message(nullptr, 0), '\0');
+    if (!s.empty()) fricont_last_error_message(&s[0], s.size() + 1);
+    return s;
+}
+
+inline std::string status_text(int32_t st) { return fricont_status_str(st); }
+
+/// Throws `Error` for a negative status (with the thread's last error message).
+inline int32_t check(int32_t st) {
+    if (st < 0) throw Error(st, last_error());
+    return st;
+}
+
+inline std::vector<Class> to_classes(const std::vector<int32_t> &codes) {
+    std::vector<Class> out;
+    out.reserve(codes.size());
+    for (int32_t c : codes) out.push_back(static_cast<Class>(c));
+    return out;
+}
+
+/// Callback context owned by the library (freed through `fricont_cxx_free_context`).
+struct LoadContext {
+    std::function<void(double, double *, std::size_t)> f;
+    std::function<void(double, double *, std::size_t)> df;
+    std::exception_ptr pending;
+};
+
+inline int32_t call_load(const std::function<void(double, double *, std::size_t)> &fn,
+                         LoadContext *ctx, double alpha, double *out, int64_t n) noexcept {
+    try {
+        fn(alpha, out, static_cast<std::size_t>(n));
+        return 0;
+    } catch (...) {
+        // Never let an exception reach the library: keep it and return a code.
+        if (!ctx->pending) ctx->pending = std::current_exception();
+        return 1;
+    }
+}
+
+extern "C" inline int32_t fricont_cxx_load_trampoline(double alpha, double *out, int64_t n,
+                                                      void *ud) {
+    auto *ctx = static_cast<LoadContext *>(ud);
+    return call_load(ctx->f, ctx, alpha, out, n);
+}
+
+extern "C" inline int32_t fricont_cxx_dload_trampoline(double alpha, double *out, int64_t n,
+                                                       void *ud) {
+    auto *ctx = static_cast<LoadContext *>(ud);
+    return call_load(ctx->df, ctx, alpha, out, n);
+}
+
+extern "C" inline void fricont_cxx_free_context(void *ud) {
+    delete static_cast<LoadContext *>(ud);
+}
+
+}  // namespace detail
+
+/// A contact problem (A, N, T, friction, gap, r). Move-only; the destructor frees it.
+class Problem {
+public:
+    /// Copies A (symmetric positive definite, in `storage`), N and T (p×n). Throws
+    /// `Error` on malformed or non-finite input (see `fricont_problem_new`).
+    Problem(const CsrRef &a, Storage storage, const CsrRef &n, const CsrRef &t) {
+        fricont_csr ca = a.c(), cn = n.c(), ct = t.c();
+        detail::check(fricont_problem_new(&ca, static_cast<int32_t>(storage), &cn, &ct, &h_));
+    }
+    Problem(const Problem &) = delete;
+    Problem &operator=(const Problem &) = delete;
+    Problem(Problem &&o) noexcept : h_(std::exchange(o.h_, nullptr)) {}
+    Problem &operator=(Problem &&o) noexcept {
+        if (this != &o) {
+            fricont_problem_free(h_);
+            h_ = std::exchange(o.h_, nullptr);
+        }
+        return *this;
+    }
+    ~Problem() { fricont_problem_free(h_); }
+
+    /// The same friction coefficient F ≥ 0 at every node.
+    void set_friction(double f) { check(fricont_problem_set_friction(h_, f)); }
+    /// One friction coefficient per node (p values).
+    void set_friction(const std::vector<double> &f) {
+        check(fricont_problem_set_friction_nodes(h_, f.data(),
+                                                 static_cast<int64_t>(f.size())));
+    }
+    /// The initial normal gap g (p values, length units).
+    void set_gap(const std::vector<double> &g) {
+        check(fricont_problem_set_gap(h_, g.data(), static_cast<int64_t>(g.size())));
+    }
+    /// The augmentation parameter r > 0 (does not change solutions).
+    void set_r(double r) { check(fricont_problem_set_r(h_, r)); }
+    /// Validates and factorises now (optional).
+    void build() { check(fricont_problem_build(h_)); }
+    /// Number of dofs n.
+    int64_t n() const {
+        int64_t n = 0;
+        check(fricont_problem_dims(h_, &n, nullptr));
+        return n;
+    }
+    /// Number of contact nodes p.
+    int64_t p() const {
+        int64_t p = 0;
+        check(fricont_problem_dims(h_, nullptr, &p));
+        return p;
+    }
+    /// The augmentation parameter in use (builds if needed).
+    double r() {
+        double r = 0.0;
+        check(fricont_problem_r(h_, &r, nullptr));
+        return r;
+    }
+    /// Its data-derived default 2p / trace(W).
+    double default_r() {
+        double r = 0.0;
+        check(fricont_problem_r(h_, nullptr, &r));
+        return r;
+    }
+    /// The C handle (still owned by this object).
+    fricont_problem *get() const noexcept { return h_; }
+
+private:
+    int32_t check(int32_t st) const {
+        if (st < 0) {
+            std::string msg(fricont_problem_error_message(h_, nullptr, 0), '\0');
+            if (!msg.empty()) fricont_problem_error_message(h_, &msg[0], msg.size() + 1);
+            else msg = detail::last_error();
+            throw Error(st, msg);
+        }
+        return st;
+    }
+    fricont_problem *h_ = nullptr;
+};
+
+/// A load path on a problem, traced step by step. Move-only; the destructor frees it.
+class Path {
+public:
+    /// A load callback: writes f(α) (or f'(α)) into `out[0..n)`. It may throw: the
+    /// exception is rethrown by the `Path` call during which it was raised.
+    using LoadFn = std::function<void(double alpha, double *out, std::size_t n)>;
+
+    /// The affine load f(α) = f0 + α f1 (n values each).
+    static Path affine(Problem &problem, const std::vector<double> &f0,
+                       const std::vector<double> &f1) {
+        if (f0.size() != f1.size())
+            throw Error(FRICONT_ERR_LENGTH, "fricont::Path::affine: f0 and f1 differ in length");
+        Path path(problem);
+        detail::check(fricont_path_new_affine(problem.get(), f0.data(), f1.data(),
+                                              static_cast<int64_t>(f0.size()), &path.h_));
+        return path;
+    }
+
+    /// A general load f(α) from a callable, with an optional derivative f'(α).
+    static Path general(Problem &problem, LoadFn f, LoadFn df = nullptr) {
+        if (!f) throw Error(FRICONT_ERR_NULL, "fricont::Path::general: empty load function");
+        Path path(problem);
+        auto *ctx = new detail::LoadContext{std::move(f), std::move(df), nullptr};
+        path.ctx_ = ctx;
+        // The library owns ctx from here: it calls fricont_cxx_free_context exactly once
+        // (also when the creation fails).
+        int32_t st = fricont_path_new_general(
+            problem.get(), path.n_, detail::fricont_cxx_load_trampoline,
+            ctx->df ? detail::fricont_cxx_dload_trampoline : nullptr, ctx,
+            detail::fricont_cxx_free_context, &path.h_);
+        if (st < 0) {
+            path.ctx_ = nullptr;
+            detail::check(st);
+        }
+        return path;
+    }
+
+    Path(const Path &) = delete;
+    Path &operator=(const Path &) = delete;
+    Path(Path &&o) noexcept
+        : h_(std::exchange(o.h_, nullptr)), ctx_(std::exchange(o.ctx_, nullptr)), n_(o.n_),
+          p_(o.p_) {}
+    Path &operator=(Path &&o) noexcept {
+        if (this != &o) {
+            fricont_path_free(h_);
+            h_ = std::exchange(o.h_, nullptr);
+            ctx_ = std::exchange(o.ctx_, nullptr);
+            n_ = o.n_;
+            p_ = o.p_;
+        }
+        return *this;
+    }
+    ~Path() { fricont_path_free(h_); }
+
+    /// Number of dofs n and contact nodes p of the problem.
+    int64_t n() const noexcept { return n_; }
+    int64_t p() const noexcept { return p_; }
+
+    /// The α window (required before `start`).
+    void set_window(double alpha_start, double alpha_end) {
+        check(fricont_path_set_window(h_, alpha_start, alpha_end));
+    }
+    /// The step limit (default 10000).
+    void set_max_steps(int64_t max_steps) { check(fricont_path_set_max_steps(h_, max_steps)); }
+    /// The relative zero tolerance of guards (default 1e-11).
+    void set_zero_tol(double tol) { check(fricont_path_set_zero_tol(h_, tol)); }
+
+    /// Starts at α from zero contact forces, or from `guess` = (λν, λt) (2p values).
+    void start(double alpha, const std::vector<double> &guess = {}) {
+        check(fricont_path_start(h_, alpha, guess.empty() ? nullptr : guess.data(),
+                                 static_cast<int64_t>(guess.size())));
+    }
+    /// Advances to the next transition point or to the end.
+    Outcome step() { return static_cast<Outcome>(check(fricont_path_step(h_))); }
+    /// Steps until the end; returns why it ended.
+    EndReason run() {
+        check(fricont_path_run(h_));
+        return end_reason();
+    }
+    /// Why the path ended (`EndReason::None` while it goes on).
+    EndReason end_reason() const {
+        int32_t r = 0;
+        check(fricont_path_end_reason(h_, &r));
+        return static_cast<EndReason>(r);
+    }
+    /// The code of the last failing load callback (0 if none).
+    int32_t callback_code() const {
+        int32_t c = 0;
+        check(fricont_path_callback_code(h_, &c));
+        return c;
+    }
+
+    /// All events so far.
+    std::vector<Event> events() const {
+        int64_t count = 0;
+        check(fricont_path_event_count(h_, &count));
+        std::vector<Event> out;
+        out.reserve(static_cast<std::size_t>(count));
+        for (int64_t k = 0; k < count; k++) {
+            fricont_event e{};
+            check(fricont_path_event(h_, k, &e));
+            out.push_back(Event{e.index, e.transition, e.alpha, e.node,
+                                static_cast<Class>(e.from), static_cast<Class>(e.to), e.fold,
+                                e.bifurcation, e.residual});
+        }
+        return out;
+    }
+    /// The full state at event k (0-based).
+    State event_state(int64_t k) const {
+        return fill([&](fricont_state *s) { return fricont_path_event_state(h_, k, s); });
+    }
+    /// The start point.
+    State start_state() const {
+        return fill([&](fricont_state *s) { return fricont_path_start_state(h_, s); });
+    }
+    /// The current point (may call the load callback).
+    State current() {
+        return fill([&](fricont_state *s) { return fricont_path_current(h_, s); });
+    }
+
+    /// The traced pieces.
+    std::vector<Piece> pieces() const {
+        int64_t count = 0;
+        check(fricont_path_piece_count(h_, &count));
+        std::vector<Piece> out;
+        for (int64_t k = 0; k < count; k++) {
+            fricont_piece pc{};
+            std::vector<int32_t> cls(static_cast<std::size_t>(p_));
+            check(fricont_path_piece(h_, k, &pc, cls.data(), p_));
+            out.push_back(Piece{pc.alpha_from, pc.alpha_to, pc.direction, pc.orientation,
+                                pc.det_sign, detail::to_classes(cls)});
+        }
+        return out;
+    }
+    /// The candidate branches at the last transition (empty unless a bifurcation).
+    std::vector<Branch> branches() const {
+        int64_t count = 0;
+        check(fricont_path_branch_count(h_, &count));
+        std::vector<Branch> out;
+        for (int64_t k = 0; k < count; k++) {
+            fricont_branch b{};
+            std::vector<int32_t> cls(static_cast<std::size_t>(p_));
+            check(fricont_path_branch(h_, k, &b, cls.data(), p_));
+            out.push_back(Branch{b.direction, b.orientation_preserving, detail::to_classes(cls)});
+        }
+        return out;
+    }
+    /// Continue along candidate branch k of the last bifurcation.
+    void choose_branch(int64_t k) { check(fricont_path_choose_branch(h_, k)); }
+
+    /// Every traced solution at α (several past a fold; none if never reached).
+    std::vector<Solution> solutions_at(double alpha) {
+        int64_t count = 0;
+        check(fricont_path_solutions_at(h_, alpha, &count));
+        std::vector<Solution> out;
+        for (int64_t k = 0; k < count; k++) {
+            fricont_solution info{};
+            State s = fill([&](fricont_state *st) {
+                return fricont_path_solution(h_, k, &info, st);
+            });
+            out.push_back(Solution{info.piece, info.continuum, std::move(s)});
+        }
+        return out;
+    }
+
+    /// The C handle (still owned by this object).
+    fricont_path *get() const noexcept { return h_; }
+
+private:
+    explicit Path(Problem &problem) : n_(problem.n()), p_(problem.p()) {}
+
+    template <class F> State fill(F call) const {
+        State s;
+        s.u.resize(static_cast<std::size_t>(n_));
+        s.lambda_n.resize(static_cast<std::size_t>(p_));
+        s.lambda_t.resize(static_cast<std::size_t>(p_));
+        std::vector<int32_t> cls(static_cast<std::size_t>(p_));
+        fricont_state st{0.0, 0.0, s.u.data(), n_, s.lambda_n.data(), p_, s.lambda_t.data(),
+                         p_, cls.data(), p_};
+        check(call(&st));
+        s.alpha = st.alpha;
+        s.residual = st.residual;
+        s.classes = detail::to_classes(cls);
+        return s;
+    }
+
+    // Rethrows an exception a load callback raised during the call that just returned,
+    // else throws `Error` with the handle's message for a negative status.
+    int32_t check(int32_t st) const {
+        if (ctx_ && ctx_->pending) {
+            std::exception_ptr e = std::exchange(ctx_->pending, nullptr);
+            std::rethrow_exception(e);
+        }
+        if (st < 0) {
+            std::string msg(fricont_path_error_message(h_, nullptr, 0), '\0');
+            if (!msg.empty()) fricont_path_error_message(h_, &msg[0], msg.size() + 1);
+            else msg = detail::last_error();
+            throw Error(st, msg);
+        }
+        return st;
+    }
+
+    fricont_path *h_ = nullptr;
+    detail::LoadContext *ctx_ = nullptr;  // owned by the library (freed with the path)
+    int64_t n_ = 0;
+    int64_t p_ = 0;
+};
+
+}  // namespace fricont
+
+#endif  // FRICONT_HPP

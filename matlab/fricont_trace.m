@@ -1,0 +1,109 @@
+function path = fricont_trace(A, N, T, f0, f1, F, window, opts)
+%FRICONT_TRACE Trace the solution path of a 2D contact problem with Coulomb friction.
+%
+%   path = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1])
+%   path = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1], opts)
+%   path = fricont_trace(A, N, T, @f, @df, F, [alpha0 alpha1], opts)
+%
+%   A      n-by-n stiffness, sparse, symmetric positive definite (Dirichlet dofs
+%          eliminated). Passed in MATLAB's own CSC form, not copied before the library
+%          copies it (see opts.storage for a triangle).
+%   N, T   p-by-n sparse: row i gives the outward normal and the tangential displacement
+%          of contact node i ((N u)_i <= gap_i is non-penetration).
+%   f0, f1 n-vectors: the affine load f(alpha) = f0 + alpha*f1 (force units of A*u).
+%          Or a function handle f(alpha) returning an n-vector, and a function handle
+%          df(alpha) for f'(alpha) or [] (then central differences are used). MATLAB
+%          evaluates them between library calls; an error they raise stops the trace
+%          and is reported by fricont_trace.
+%   F      friction coefficient, a scalar or a p-vector (>= 0).
+%   [alpha0 alpha1]  the window: traced from alpha0 toward alpha1.
+%   opts   struct, all fields optional:
+%          gap (p-vector, default 0), r (augmentation parameter, default 2p/trace(W)),
+%          storage ('full' default, 'lower' or 'upper': which triangle of A is stored),
+%          max_steps (default 10000), zero_tol (default 1e-11),
+%          guess (2p-vector [lambda_n; lambda_t] for the start solve).
+%
+%   path   struct:
+%     events  struct array, one per node changing class, in order: index, transition,
+%             alpha, node (contact nodes count from 1), from, to ('open', 'stick',
+%             'slip+', 'slip-'), fold, bifurcation, residual, and the state after it:
+%             u (n-by-1), lambda_n, lambda_t (p-by-1, lambda_n <= 0 compressive),
+%             classes (p-by-1 cell of names).
+%     pieces  struct array: alpha_from, alpha_to, direction, orientation, det_sign,
+%             classes.
+%     start   the start point (alpha, residual, u, lambda_n, lambda_t, classes).
+%     end_reason  'window', 'max_steps', 'closed_loop', 'bifurcation' or 'failed'.
+%     n, p, r, window, and handle/load (used by fricont_solutions_at; the library path
+%     is freed when the last copy of the struct is cleared).
+%
+%   See also FRICONT_SOLUTIONS_AT.
+  if nargin < 7
+    error('fricont:argument', 'fricont_trace: needs A, N, T, f0, f1, F and the window');
+  end
+  if nargin < 8 || isempty(opts)
+    opts = struct();
+  end
+  if ~isstruct(opts)
+    error('fricont:argument', 'fricont_trace: opts must be a struct');
+  end
+  if ~isnumeric(window) || numel(window) ~= 2
+    error('fricont:argument', 'fricont_trace: the window is [alpha_start alpha_end]');
+  end
+  storage = 'full';
+  if isfield(opts, 'storage')
+    storage = opts.storage;
+  end
+
+  prob = fricont_mex('problem_new', as_sparse(A, 'A'), storage, as_sparse(N, 'N').', ...
+                     as_sparse(T, 'T').');
+  free_problem = onCleanup(@() fricont_mex('free', prob));
+  fricont_mex('problem_set', prob, 'friction', full(double(F(:))));
+  if isfield(opts, 'gap')
+    fricont_mex('problem_set', prob, 'gap', full(double(opts.gap(:))));
+  end
+  if isfield(opts, 'r')
+    fricont_mex('problem_set', prob, 'r', double(opts.r));
+  end
+  r = fricont_mex('problem_r', prob);
+  n = size(A, 1);
+
+  if isa(f0, 'function_handle')
+    if ~isempty(f1) && ~isa(f1, 'function_handle')
+      error('fricont:argument', 'fricont_trace: with a load function, df is a function handle or []');
+    end
+    load = struct('f', f0, 'df', f1);
+    id = fricont_mex('path_new_general', prob, double(~isempty(f1)));
+  else
+    load = [];
+    id = fricont_mex('path_new_affine', prob, full(double(f0(:))), full(double(f1(:))));
+  end
+  handle = fricont_handle(id);
+  clear free_problem;                 % the path keeps what it needs
+
+  fricont_mex('path_set', id, 'window', double(window(:).'));
+  if isfield(opts, 'max_steps')
+    fricont_mex('path_set', id, 'max_steps', double(opts.max_steps));
+  end
+  if isfield(opts, 'zero_tol')
+    fricont_mex('path_set', id, 'zero_tol', double(opts.zero_tol));
+  end
+  guess = [];
+  if isfield(opts, 'guess')
+    guess = full(double(opts.guess(:)));
+  end
+  fricont_drive(id, load, n, 'start', double(window(1)), guess);
+  fricont_drive(id, load, n, 'run');
+
+  path = fricont_mex('path_result', id);
+  path.r = r;
+  path.window = double(window(:).');
+  path.handle = handle;
+  path.load = load;
+end
+
+function S = as_sparse(M, name)
+  if ~isnumeric(M) || ~isreal(M) || ndims(M) ~= 2
+    error('fricont:argument', 'fricont_trace: %s must be a real matrix', name);
+  end
+  S = sparse(double(M));
+end

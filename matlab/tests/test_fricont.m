@@ -1,0 +1,183 @@
+function failures = test_fricont(case_dir, out_dir)
+%TEST_FRICONT Tests of the MATLAB/Octave binding on a problem in the exchange format.
+%   Writes the traced events to out_dir/{affine,handle,handle_nodf,lower}.txt (compared
+%   with the C interface's by matlab/run.sh) and prints "ok NAME" / "FAIL NAME: why".
+  failures = 0;
+  c = read_case(case_dir);
+  n = size(c.A, 1);
+  p = size(c.N, 1);
+  opts = struct('gap', c.gap);
+  win = [c.alpha_start c.alpha_end];
+
+  % 1. Affine load.
+  path = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts);
+  write_events(fullfile(out_dir, 'affine.txt'), path, @(a) a);
+  failures = failures + check('affine: ends at the window', strcmp(path.end_reason, 'window'));
+  failures = failures + check('affine: pieces = events + 1', numel(path.pieces) == numel(path.events) + 1);
+  failures = failures + check('handle locks the MEX file', fricont_mex('is_locked'));
+  ev = path.events;
+
+  % 2. Solutions between the first two events satisfy the equations (checked here).
+  alpha = (ev(1).alpha + ev(2).alpha) / 2;
+  S = fricont_solutions_at(path, alpha);
+  failures = failures + check('solutions_at: one solution on piece 2', numel(S) == 1 && S(1).piece == 2);
+  f = c.f0 + alpha * c.f1;
+  [ok, why] = check_solution(c, S(1), f);
+  failures = failures + check('solutions_at: equilibrium and contact conditions', ok, why);
+  [ok, why] = check_solution(c, ev(1), c.f0 + ev(1).alpha * c.f1);
+  failures = failures + check('event state: equilibrium and contact conditions', ok, why);
+  failures = failures + check('solutions_at: none outside the traced range', ...
+                    isempty(fricont_solutions_at(path, c.alpha_end + 1)));
+
+  % 3. A load given as a function handle, f(s) = f0 + sinh(s) f1, with and without
+  %    its derivative: the events are at asinh of the affine ones.
+  swin = asinh(win);
+  ph = fricont_trace(c.A, c.N, c.T, @(s) c.f0 + sinh(s) * c.f1, @(s) cosh(s) * c.f1, ...
+                     c.F, swin, opts);
+  write_events(fullfile(out_dir, 'handle.txt'), ph, @sinh);
+  ph2 = fricont_trace(c.A, c.N, c.T, @(s) c.f0 + sinh(s) * c.f1, [], c.F, swin, opts);
+  write_events(fullfile(out_dir, 'handle_nodf.txt'), ph2, @sinh);
+  Sh = fricont_solutions_at(ph, asinh(alpha));
+  failures = failures + check('solutions_at through a load function: same u', numel(Sh) == 1 && ...
+                    norm(Sh(1).u - S(1).u, inf) <= 1e-8 * norm(S(1).u, inf));
+
+  % 4. The lower triangle of A with storage 'lower' gives the same path.
+  pl = fricont_trace(tril(c.A), c.N, c.T, c.f0, c.f1, c.F, win, ...
+                     struct('gap', c.gap, 'storage', 'lower'));
+  write_events(fullfile(out_dir, 'lower.txt'), pl, @(a) a);
+
+  % 5. An error in the load function: raised by fricont_trace, after the library call
+  %    returned; nothing is left allocated.
+  clear path ph ph2 pl;
+  failures = failures + check('every handle freed when the structs are cleared', fricont_mex('count') == 0);
+  failures = failures + check('MEX file unlocked without handles', ~fricont_mex('is_locked'));
+  stop = (ev(2).alpha + ev(3).alpha) / 2;
+  msg = '';
+  try
+    fricont_trace(c.A, c.N, c.T, @(a) failing_load(a, stop, c), [], c.F, win, opts);
+  catch err
+    msg = err.message;
+    ident = err.identifier;
+  end
+  failures = failures + check('load function error: raised as fricont:load', ...
+                    ~isempty(msg) && strcmp(ident, 'fricont:load') && ...
+                    ~isempty(strfind(msg, 'load not defined past the stop')), msg);
+  failures = failures + check('load function error: nothing left allocated', fricont_mex('count') == 0);
+  msg = '';
+  try
+    fricont_trace(c.A, c.N, c.T, @(a) ones(3, 1), [], c.F, win, opts);
+  catch err
+    msg = err.message;
+  end
+  failures = failures + check('load function of the wrong length: clear error', ...
+                    ~isempty(strfind(msg, 'real vector of n = ')), msg);
+
+  % 6. Bad input: library errors with their status as identifier.
+  ident = '';
+  try
+    fricont_trace(c.A, c.N(:, 1:end-1), c.T, c.f0, c.f1, c.F, win, opts);
+  catch err
+    ident = err.identifier;
+    msg = err.message;
+  end
+  failures = failures + check('N with a wrong column count: fricont:ERR_LENGTH', ...
+                    strcmp(ident, 'fricont:ERR_LENGTH'), [ident ' ' msg]);
+  ident = '';
+  try
+    fricont_trace(c.A, c.N, c.T, c.f0, c.f1, -1, win, opts);
+  catch err
+    ident = err.identifier;
+  end
+  failures = failures + check('negative friction: fricont:ERR_RANGE', strcmp(ident, 'fricont:ERR_RANGE'), ident);
+  ident = '';
+  try
+    fricont_mex('path_result', uint64(123456));
+  catch err
+    ident = err.identifier;
+  end
+  failures = failures + check('unknown handle: fricont:handle', strcmp(ident, 'fricont:handle'), ident);
+  ident = '';
+  try
+    fricont_mex('path_result', 3);
+  catch err
+    ident = err.identifier;
+  end
+  failures = failures + check('handle of the wrong class: fricont:handle', strcmp(ident, 'fricont:handle'), ident);
+
+  % 7. A request MATLAB abandons (as after Ctrl-C) does not hang or leak: freeing the
+  %    handle ends the pending library call.
+  prob = fricont_mex('problem_new', c.A, 'full', c.N.', c.T.');
+  fricont_mex('problem_set', prob, 'friction', c.F);
+  id = fricont_mex('path_new_general', prob, 0);
+  fricont_mex('free', prob);
+  fricont_mex('path_set', id, 'window', win);
+  [what, value] = fricont_mex('path_call', id, 'start', win(1), []);
+  failures = failures + check('a load request reaches MATLAB', strcmp(what, 'f') && value == win(1), what);
+  fricont_mex('free', id);
+  failures = failures + check('abandoned request: handle freed', fricont_mex('count') == 0);
+  fprintf('matlab test_fricont: %d failed check(s)\n', failures);
+end
+
+function f = failing_load(a, stop, c)
+  if a > stop
+    error('test:stop', 'load not defined past the stop');
+  end
+  f = c.f0 + a * c.f1;
+end
+
+function bad = check(name, cond, why)
+  bad = ~cond;
+  if cond
+    fprintf('ok %s\n', name);
+  elseif nargin > 2
+    fprintf('FAIL %s: %s\n', name, why);
+  else
+    fprintf('FAIL %s\n', name);
+  end
+end
+
+% Equilibrium A u = f + N' lambda_n + T' lambda_t and each node's class conditions.
+function [ok, why] = check_solution(c, s, f)
+  why = '';
+  res = norm(c.A * s.u - f - c.N.' * s.lambda_n - c.T.' * s.lambda_t, inf) / norm(f, inf);
+  dn = c.N * s.u - c.gap;
+  dt = c.T * s.u;
+  tl = 1e-9 * norm(s.u, inf);
+  tf = 1e-9 * max(abs([s.lambda_n; s.lambda_t]));
+  F = c.F .* ones(size(dn));
+  ok = res <= 1e-9;
+  if ~ok
+    why = sprintf('equilibrium residual %.3g', res);
+  end
+  for i = 1:numel(dn)
+    ln = s.lambda_n(i); lt = s.lambda_t(i);
+    good = ln <= tf && dn(i) <= tl && abs(lt) <= -F(i) * ln + tf;
+    switch s.classes{i}
+      case 'open'
+        good = good && abs(ln) <= tf && abs(lt) <= tf;
+      case 'stick'
+        good = good && abs(dn(i)) <= tl && abs(dt(i)) <= tl;
+      case 'slip+'
+        good = good && abs(dn(i)) <= tl && abs(lt - F(i) * ln) <= tf && dt(i) >= -tl;
+      case 'slip-'
+        good = good && abs(dn(i)) <= tl && abs(lt + F(i) * ln) <= tf && dt(i) <= tl;
+    end
+    if ~good
+      ok = false;
+      why = sprintf('node %d violates %s', i, s.classes{i});
+      return;
+    end
+  end
+end
+
+% The events in the plain text form of tests-install/trace_case.c (alpha mapped).
+function write_events(file, path, map)
+  fid = fopen(file, 'w');
+  fprintf(fid, 'start %.17g %.3e\n', map(path.start.alpha), path.start.residual);
+  for e = path.events(:).'
+    fprintf(fid, 'event %d %d %.17g %d %s %s %d %d\n', e.index, e.transition, map(e.alpha), ...
+            e.node, e.from, e.to, e.fold, e.bifurcation);
+  end
+  fprintf(fid, 'end %s %d\n', path.end_reason, numel(path.pieces));
+  fclose(fid);
+end

@@ -1,0 +1,1207 @@
+//! The path handle: a load bound to a problem, stepping, events, states, queries.
+
+use std::cell::RefCell;
+use std::ffi::{c_char, c_void};
+use std::sync::Arc;
+
+use super::boundary::{
+    ErrorSlot, Failure, FfiResult, HasSlot, ffi_boundary, handle_ref, len_of, put, slice_in,
+    slice_out, write_message,
+};
+use super::problem::fricont_problem;
+use super::status::{class_code, fricont_end_reason, fricont_status};
+use crate::load::{Load, LoadFailure};
+use crate::path::{EndReason, Path, PathOptions, Solution, State, StepOutcome};
+use crate::problem::Problem;
+
+/// A general load callback: writes `f(α)` (or its derivative `f'(α)` when registered as
+/// the derivative) into `f_out[0..n)`.
+///
+/// * `alpha`: the load parameter.
+/// * `f_out`: n doubles owned by the library, valid only during the call (do not keep the
+///   pointer). Force units are those of `A u`.
+/// * `n`: the number of dofs.
+/// * `user_data`: the pointer given to `fricont_path_new_general`.
+///
+/// Return 0 on success. Any other value aborts the current step: the calling function
+/// returns `FRICONT_ERR_CALLBACK`, the path ends (`FRICONT_END_FAILED`) keeping what it
+/// traced, and the value is kept for `fricont_path_callback_code`. A NaN or infinity in
+/// `f_out` is treated the same way (`FRICONT_ERR_CALLBACK_VALUE`). Callbacks are called
+/// synchronously, on the thread that called into the library, possibly several times per
+/// step and at α slightly outside the window (finite differences). They must not throw
+/// (C++), `longjmp`, call `mexErrMsgTxt`, or call back into the same path handle: return
+/// a code instead.
+#[allow(non_camel_case_types)]
+pub type fricont_load_fn = Option<
+    unsafe extern "C" fn(alpha: f64, f_out: *mut f64, n: i64, user_data: *mut c_void) -> i32,
+>;
+
+/// A basis-weights callback for `f(α) = Σ_j φ_j(α) f_j`: writes `φ_j(α)` into `phi[0..k)`
+/// and `φ_j'(α)` into `dphi[0..k)` (both arrays owned by the library, valid only during
+/// the call). `user_data` is the pointer given to `fricont_path_new_basis`. Same return
+/// contract as `fricont_load_fn`.
+#[allow(non_camel_case_types)]
+pub type fricont_weights_fn = Option<
+    unsafe extern "C" fn(
+        alpha: f64,
+        phi: *mut f64,
+        dphi: *mut f64,
+        k: i64,
+        user_data: *mut c_void,
+    ) -> i32,
+>;
+
+/// A finalizer for a callback's `user_data`: called exactly once with `user_data` when
+/// the library no longer needs it (see the `fricont_path_new_*` functions).
+#[allow(non_camel_case_types)]
+pub type fricont_free_fn = Option<unsafe extern "C" fn(user_data: *mut c_void)>;
+
+/// One node changing class at a transition point (a plain value, copied out by
+/// `fricont_path_event`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(non_camel_case_types)]
+pub struct fricont_event {
+    /// 0-based position in the path's event list.
+    pub index: i64,
+    /// 0-based number of the transition point; the events of one degenerate transition
+    /// (several nodes switching at the same α) share it and come in node order.
+    pub transition: i64,
+    /// α at the transition point.
+    pub alpha: f64,
+    /// **0-based** contact node (row of N and T). Reports and the paper count from 1: print
+    /// `node + 1`.
+    pub node: i64,
+    /// Class before the event (`fricont_class` code).
+    pub from: i32,
+    /// Class after the event (`fricont_class` code).
+    pub to: i32,
+    /// α turns back here (the sign of dα/ds after the transition is opposite to before).
+    pub fold: bool,
+    /// More than one neighbouring piece continues the path here.
+    pub bifurcation: bool,
+    /// ‖H‖∞ at the transition point divided by the data's scale (dimensionless).
+    pub residual: f64,
+}
+
+/// A point of the solution curve, written into buffers that the caller owns. The caller
+/// sets the four buffer pointers and lengths; the library writes `alpha`, `residual` and
+/// the buffers. Each buffer pointer may be NULL (that part is not written, its length is
+/// ignored); otherwise its length must be at least the size it receives (n for `u`, p for
+/// the others), else the call fails with `FRICONT_ERR_LENGTH` and writes nothing.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+#[allow(non_camel_case_types)]
+pub struct fricont_state {
+    /// Output: the load parameter α.
+    pub alpha: f64,
+    /// Output: ‖H‖∞ / data scale at this point (dimensionless).
+    pub residual: f64,
+    /// Displacements u (n values, length units), or NULL.
+    pub u: *mut f64,
+    /// Length of `u` (≥ n when `u` is not NULL).
+    pub u_len: i64,
+    /// Normal contact forces λν (p values, ≤ 0: compressive), or NULL.
+    pub lambda_n: *mut f64,
+    /// Length of `lambda_n` (≥ p when not NULL).
+    pub lambda_n_len: i64,
+    /// Tangential contact forces λt (p values), or NULL.
+    pub lambda_t: *mut f64,
+    /// Length of `lambda_t` (≥ p when not NULL).
+    pub lambda_t_len: i64,
+    /// Class of every node (p `fricont_class` codes) on the piece the point is reported
+    /// for, or NULL. At an event: the classes of the piece after it.
+    pub classes: *mut i32,
+    /// Length of `classes` (≥ p when not NULL).
+    pub classes_len: i64,
+}
+
+/// A traced smooth piece (copied out by `fricont_path_piece`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(non_camel_case_types)]
+pub struct fricont_piece {
+    /// α where the path entered the piece.
+    pub alpha_from: f64,
+    /// α where the path left it (so far, for the current piece); equal to `alpha_from`
+    /// for a vertical piece.
+    pub alpha_to: f64,
+    /// Sign of dα/ds on the piece: +1, −1, or 0 for a vertical piece (a continuum of
+    /// solutions at one α).
+    pub direction: i32,
+    /// The path's orientation sign, sign det [J; tᵀ] with J = ∂H/∂(λ, α) on the piece and t
+    /// its tangent; constant along a path (folds show as a change of `direction`).
+    pub orientation: i32,
+    /// Sign of det ∂H/∂λ on the piece (0 if singular).
+    pub det_sign: i32,
+}
+
+/// A candidate continuation at a bifurcation (copied out by `fricont_path_branch`).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(non_camel_case_types)]
+pub struct fricont_branch {
+    /// Sign of dα/ds along the branch (0 for a vertical piece).
+    pub direction: i32,
+    /// True if it keeps the path's orientation.
+    pub orientation_preserving: bool,
+}
+
+/// Where a solution from `fricont_path_solutions_at` comes from.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(non_camel_case_types)]
+pub struct fricont_solution {
+    /// 0-based index of the traced piece (`fricont_path_piece`) that gave it.
+    pub piece: i64,
+    /// True when that piece is vertical at this α: every point between the piece's ends
+    /// is a solution too (a continuum).
+    pub continuum: bool,
+}
+
+/// The caller's `user_data` with its finalizer, shared by the load closures.
+struct UserData {
+    ptr: *mut c_void,
+    free: fricont_free_fn,
+}
+
+impl Drop for UserData {
+    fn drop(&mut self) {
+        if let Some(free) = self.free {
+            // SAFETY: the caller's finalizer, called once with its own pointer.
+            unsafe { free(self.ptr) }
+        }
+    }
+}
+
+// SAFETY: the library never dereferences `ptr`; it only hands it back to the caller's
+// callbacks, which run synchronously on the thread that is using the path handle. A path
+// handle is used by one thread at a time (documented), so `user_data` is never touched by
+// two threads at once through the library. The load closures must be `Send` because the
+// Rust `Path` is.
+unsafe impl Send for UserData {}
+// SAFETY: as above; shared references only let the closures read the pointer value.
+unsafe impl Sync for UserData {}
+
+/// A path: a load bound to a problem, traced step by step. Opaque.
+///
+/// Created by `fricont_path_new_affine`, `_basis` or `_general`, configured by the
+/// `fricont_path_set_*` setters, started by `fricont_path_start`, advanced by
+/// `fricont_path_step` / `fricont_path_run`, freed by `fricont_path_free`.
+///
+/// A path handle must not be used by two threads at the same time; different path handles
+/// (on the same problem or not) may be used from different threads at once. Its load
+/// callbacks run on the thread that calls into the path.
+#[allow(non_camel_case_types)]
+pub struct fricont_path {
+    slot: ErrorSlot,
+    /// Only shared references to the handle are ever formed (the slot is read by the
+    /// boundary while the body runs); the mutable part sits in a `RefCell`. A callback that
+    /// re-enters the same handle hits the borrow check, a caught panic.
+    inner: RefCell<PathInner>,
+}
+
+struct PathInner {
+    n: usize,
+    p: usize,
+    problem: Arc<Problem>,
+    /// The load until the Rust path is created at the first start.
+    load: Option<Load>,
+    window: Option<(f64, f64)>,
+    max_steps: usize,
+    zero_tol: f64,
+    path: Option<Path>,
+    solutions: Vec<Solution>,
+}
+
+impl HasSlot for fricont_path {
+    fn slot(&self) -> &ErrorSlot {
+        &self.slot
+    }
+}
+
+const NOT_STARTED: &str = "the path has not been started: call fricont_path_start first";
+
+impl PathInner {
+    fn started(&self) -> FfiResult<&Path> {
+        match &self.path {
+            Some(p) if p.is_started() => Ok(p),
+            _ => Err(Failure::order(NOT_STARTED)),
+        }
+    }
+
+    fn started_mut(&mut self) -> FfiResult<&mut Path> {
+        match &mut self.path {
+            Some(p) if p.is_started() => Ok(p),
+            _ => Err(Failure::order(NOT_STARTED)),
+        }
+    }
+
+    fn configurable(&self, what: &str) -> FfiResult<()> {
+        if self.path.is_some() {
+            return Err(Failure::order(format!(
+                "{what} can only be set before the first fricont_path_start"
+            )));
+        }
+        Ok(())
+    }
+
+    /// Copies a state into the caller's buffers (all checked before anything is written).
+    fn fill_state(&self, st: &State, out: *mut fricont_state) -> FfiResult<()> {
+        // SAFETY: NULL or a caller-initialised struct, by the exported functions' contract.
+        let Some(out) = (unsafe { out.as_mut() }) else {
+            return Ok(());
+        };
+        let (n, p) = (self.n, self.p);
+        // SAFETY: the caller's buffers are valid for their stated lengths.
+        let (u, ln, lt, cl) = unsafe {
+            (
+                slice_out(out.u, out.u_len, n, "u")?,
+                slice_out(out.lambda_n, out.lambda_n_len, p, "lambda_n")?,
+                slice_out(out.lambda_t, out.lambda_t_len, p, "lambda_t")?,
+                slice_out(out.classes, out.classes_len, p, "classes")?,
+            )
+        };
+        if let Some(u) = u {
+            u.copy_from_slice(&st.u);
+        }
+        if let Some(l) = ln {
+            l.copy_from_slice(&st.lambda_n);
+        }
+        if let Some(l) = lt {
+            l.copy_from_slice(&st.lambda_t);
+        }
+        if let Some(c) = cl {
+            for (c, k) in c.iter_mut().zip(&st.classes) {
+                *c = class_code(*k);
+            }
+        }
+        out.alpha = st.alpha;
+        out.residual = st.residual;
+        Ok(())
+    }
+}
+
+fn index_in(k: i64, count: usize, what: &str) -> FfiResult<usize> {
+    usize::try_from(k)
+        .ok()
+        .filter(|&k| k < count)
+        .ok_or_else(|| Failure::range(format!("{what} index {k} is outside 0..{count}")))
+}
+
+/// Common part of the three constructors.
+///
+/// # Safety
+/// `problem` is NULL or live; `out` is NULL or valid for one write.
+unsafe fn new_path(
+    problem: *mut fricont_problem,
+    out: *mut *mut fricont_path,
+    make_load: impl FnOnce(usize) -> FfiResult<Load>,
+) -> FfiResult {
+    if out.is_null() {
+        return Err(Failure::null(
+            "out (the fricont_path ** receiving the handle)",
+        ));
+    }
+    // SAFETY: valid by contract; cleared before anything can fail.
+    unsafe { out.write(std::ptr::null_mut()) };
+    // SAFETY: NULL or live, by contract.
+    let prob = unsafe { handle_ref(problem, "problem") }?;
+    let (shared, n, p) = prob.shared()?;
+    let load = make_load(n)?;
+    if load.n() != n {
+        return Err(Failure::length(format!(
+            "the load has {} entries, the problem has n = {n} dofs",
+            load.n()
+        )));
+    }
+    let handle = Box::new(fricont_path {
+        slot: ErrorSlot::default(),
+        inner: RefCell::new(PathInner {
+            n,
+            p,
+            problem: shared,
+            load: Some(load),
+            window: None,
+            max_steps: 10_000,
+            zero_tol: 1e-11,
+            path: None,
+            solutions: Vec::new(),
+        }),
+    });
+    // SAFETY: valid by contract.
+    unsafe { out.write(Box::into_raw(handle)) };
+    Ok(fricont_status::FRICONT_OK)
+}
+
+/// Creates a path with the affine load `f(α) = f0 + α f1` on a problem (building the
+/// problem first if its settings changed since the last build).
+///
+/// * `problem`: not NULL. The path keeps its own reference to the factorised problem; the
+///   handle may be freed afterwards.
+/// * `f0`, `f1`: n values each (force units of `A u`), read during the call and copied.
+///   Not NULL (unless `n` = 0, which is an error anyway).
+/// * `n`: their length; must equal the problem's n.
+/// * `out`: receives the handle (NULL on failure). Not NULL.
+///
+/// The path must be given an α window (`fricont_path_set_window`) before it is started.
+/// For an affine load every piece of the solution curve is a straight segment and every
+/// transition point is found exactly.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_LENGTH` (`n` ≠ the problem's n),
+/// `FRICONT_ERR_NONFINITE` (NaN or infinity in f0 or f1), the errors of
+/// `fricont_problem_build`, `FRICONT_ERR_POISONED` (problem), `FRICONT_ERR_PANIC`. Error
+/// messages go to the problem handle and to `fricont_last_error_message`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `f0`, `f1` are NULL or valid for `n` reads; `out`
+/// is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_new_affine(
+    problem: *mut fricont_problem,
+    f0: *const f64,
+    f1: *const f64,
+    n: i64,
+    out: *mut *mut fricont_path,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        let make = |_| {
+            let len = len_of(n, "n")?;
+            // SAFETY: NULL or valid for `n` reads, by contract.
+            let (a, b) = unsafe { (slice_in(f0, len, "f0")?, slice_in(f1, len, "f1")?) };
+            Ok(Load::affine(a.to_vec(), b.to_vec())?)
+        };
+        // SAFETY: by this function's contract.
+        unsafe { new_path(problem, out, make) }
+    })
+}
+
+/// Creates a path with the load `f(α) = Σ_j φ_j(α) f_j`, j = 0..k−1: k fixed vectors with
+/// scalar weights from a callback. One solve per vector at creation; each α then costs
+/// nothing but the callback.
+///
+/// * `problem`: not NULL (see `fricont_path_new_affine`).
+/// * `vectors`: the k vectors, each of n values, stored one after the other (column-major
+///   n×k: vector j starts at `vectors + j*n`); read during the call and copied. Not NULL.
+/// * `n`: must equal the problem's n. `k`: ≥ 1.
+/// * `weights`: writes φ_j(α) and φ_j'(α) (see `fricont_weights_fn`). Not NULL.
+/// * `user_data`: passed to `weights`; may be NULL. The library never dereferences it.
+/// * `free_user_data`: may be NULL. If given, it is called exactly once with `user_data`:
+///   by `fricont_path_free`, or before this function returns if it fails.
+/// * `out`: receives the handle (NULL on failure). Not NULL.
+///
+/// Returns as `fricont_path_new_affine`, plus `FRICONT_ERR_LENGTH` for k < 1 and
+/// `FRICONT_ERR_NULL` for a NULL `weights`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `vectors` is NULL or valid for `n*k` reads; `out`
+/// is NULL or valid for one write; the callback and finalizer follow their contracts.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub unsafe extern "C" fn fricont_path_new_basis(
+    problem: *mut fricont_problem,
+    vectors: *const f64,
+    n: i64,
+    k: i64,
+    weights: fricont_weights_fn,
+    user_data: *mut c_void,
+    free_user_data: fricont_free_fn,
+    out: *mut *mut fricont_path,
+) -> fricont_status {
+    // Owned here so that the finalizer runs even if the boundary refuses the call.
+    let ud = Arc::new(UserData {
+        ptr: user_data,
+        free: free_user_data,
+    });
+    ffi_boundary!(problem => {
+        let ud = ud;
+        let make = |_| {
+                let len = len_of(n, "n")?;
+                let k = len_of(k, "k")?;
+                if k == 0 {
+                    return Err(Failure::length("k = 0: a basis load needs at least one vector"));
+                }
+                let weights = weights.ok_or_else(|| Failure::null("weights (the callback)"))?;
+                // SAFETY: NULL or valid for `n*k` reads, by contract.
+                let all = unsafe { slice_in(vectors, len * k, "vectors") }?;
+                let vecs: Vec<Vec<f64>> = all.chunks(len.max(1)).map(|c| c.to_vec()).collect();
+                let ud = ud.clone();
+                let f = move |alpha: f64, phi: &mut [f64], dphi: &mut [f64]| {
+                    // SAFETY: the caller's callback with library-owned buffers of k values.
+                    let code = unsafe {
+                        weights(alpha, phi.as_mut_ptr(), dphi.as_mut_ptr(), phi.len() as i64, ud.ptr)
+                    };
+                    if code == 0 {
+                        Ok(())
+                    } else {
+                        Err(LoadFailure {
+                            code,
+                            message: format!("the basis weights callback returned {code}"),
+                        })
+                    }
+                };
+                Ok(Load::basis(vecs, Box::new(f))?)
+        };
+        // SAFETY: by this function's contract.
+        unsafe { new_path(problem, out, make) }
+    })
+}
+
+/// Creates a path with a general load `f(α)` computed by a callback, with an optional
+/// derivative callback. Each evaluation costs one solve with the Cholesky factor of A.
+/// Without a derivative, f'(α) is approximated by central differences (used only for step
+/// control and orientation: transition points are located on the guards themselves).
+///
+/// * `problem`: not NULL (see `fricont_path_new_affine`).
+/// * `n`: the load's length; must equal the problem's n.
+/// * `f`: writes f(α) (see `fricont_load_fn`). Not NULL.
+/// * `df`: writes f'(α), or NULL.
+/// * `user_data`: passed to both callbacks; may be NULL; never dereferenced.
+/// * `free_user_data`: may be NULL. If given, it is called exactly once with `user_data`:
+///   by `fricont_path_free`, or before this function returns if it fails.
+/// * `out`: receives the handle (NULL on failure). Not NULL.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`, `f`, `out`), `FRICONT_ERR_LENGTH`,
+/// the errors of `fricont_problem_build`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// The callbacks are not called here.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `out` is NULL or valid for one write; the callbacks
+/// and finalizer follow their contracts.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_new_general(
+    problem: *mut fricont_problem,
+    n: i64,
+    f: fricont_load_fn,
+    df: fricont_load_fn,
+    user_data: *mut c_void,
+    free_user_data: fricont_free_fn,
+    out: *mut *mut fricont_path,
+) -> fricont_status {
+    let ud = Arc::new(UserData {
+        ptr: user_data,
+        free: free_user_data,
+    });
+    ffi_boundary!(problem => {
+        let ud = ud;
+        let make = |_| {
+                let len = len_of(n, "n")?;
+                let f = f.ok_or_else(|| Failure::null("f (the load callback)"))?;
+                let wrap = |cb: unsafe extern "C" fn(f64, *mut f64, i64, *mut c_void) -> i32,
+                            what: &'static str| {
+                    let ud = ud.clone();
+                    Box::new(move |alpha: f64, out: &mut [f64]| {
+                        // SAFETY: the caller's callback with a library-owned buffer of n values.
+                        let code = unsafe { cb(alpha, out.as_mut_ptr(), out.len() as i64, ud.ptr) };
+                        if code == 0 {
+                            Ok(())
+                        } else {
+                            Err(LoadFailure {
+                                code,
+                                message: format!("the {what} callback returned {code}"),
+                            })
+                        }
+                    }) as crate::load::VectorFn
+                };
+                let fv = wrap(f, "load");
+                let dfv = df.map(|d| wrap(d, "load derivative"));
+                Ok(Load::general(len, fv, dfv))
+        };
+        // SAFETY: by this function's contract.
+        unsafe { new_path(problem, out, make) }
+    })
+}
+
+/// Frees a path handle (and, through the finalizer, its callbacks' `user_data`). NULL is a
+/// no-op. Never use the handle afterwards.
+///
+/// # Safety
+/// `path` is NULL or a handle from `fricont_path_new_*` not freed before, not in use by
+/// another thread.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_free(path: *mut fricont_path) {
+    super::boundary::run_value((), || {
+        if !path.is_null() {
+            // SAFETY: a live handle from `Box::into_raw`, by contract.
+            drop(unsafe { Box::from_raw(path) });
+        }
+    })
+}
+
+/// Sets the α window: the path is traced from `alpha_start` toward `alpha_end` and ends
+/// (`FRICONT_END_WINDOW`) when α leaves `[min, max]` of the two, on either side (after a
+/// fold it may leave through the start). Required before the first `fricont_path_start`;
+/// no default.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (not finite or equal),
+/// `FRICONT_ERR_ORDER` (after the first start), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_set_window(
+    path: *mut fricont_path,
+    alpha_start: f64,
+    alpha_end: f64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        h.configurable("the alpha window")?;
+        if !alpha_start.is_finite() || !alpha_end.is_finite() || alpha_start == alpha_end {
+            return Err(Failure::range(format!(
+                "alpha window [{alpha_start}, {alpha_end}] must be finite with distinct ends"
+            )));
+        }
+        h.window = Some((alpha_start, alpha_end));
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Sets the step limit: the path ends (`FRICONT_END_MAX_STEPS`) after this many transition
+/// points. Default 10000; must be ≥ 1. Only before the first start.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (< 1), `FRICONT_ERR_ORDER`
+/// (after the first start), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_set_max_steps(
+    path: *mut fricont_path,
+    max_steps: i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        h.configurable("the step limit")?;
+        if max_steps < 1 {
+            return Err(Failure::range(format!("max_steps = {max_steps}, must be >= 1")));
+        }
+        h.max_steps = usize::try_from(max_steps).unwrap_or(usize::MAX);
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Sets the relative tolerance for "a guard is at zero" and "several nodes switch at
+/// once" (dimensionless, relative to the force scale of the current point). Default 1e-11;
+/// must be in (0, 1e-3]. Only before the first start.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE`, `FRICONT_ERR_ORDER`
+/// (after the first start), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_set_zero_tol(
+    path: *mut fricont_path,
+    zero_tol: f64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        h.configurable("the zero tolerance")?;
+        if !(zero_tol > 0.0 && zero_tol <= 1e-3) {
+            return Err(Failure::range(format!("zero_tol = {zero_tol}, must be in (0, 1e-3]")));
+        }
+        h.zero_tol = zero_tol;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Starts (or restarts) the path at `alpha` with the fixed-α solver (semi-smooth Newton
+/// with globalisation), from the contact forces `guess` = (λν, λt) or, if `guess` is
+/// NULL, from zero forces. A restart clears the events and pieces traced so far. The load
+/// callbacks may be called.
+///
+/// * `alpha`: inside the window set by `fricont_path_set_window`.
+/// * `guess`: NULL, or 2p values: λν of nodes 0..p−1 then λt of nodes 0..p−1; copied.
+/// * `guess_len`: 2p when `guess` is not NULL (ignored otherwise).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_LENGTH` (`guess_len` ≠
+/// 2p), `FRICONT_ERR_NONFINITE` (guess), `FRICONT_ERR_RANGE` (α not finite or outside the
+/// window), `FRICONT_ERR_ORDER` (no window set), `FRICONT_ERR_SOLVE_FAILED`,
+/// `FRICONT_ERR_CALLBACK`, `FRICONT_ERR_CALLBACK_VALUE`, `FRICONT_ERR_NUMERICAL`,
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `guess` is NULL or valid for `guess_len` reads.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_start(
+    path: *mut fricont_path,
+    alpha: f64,
+    guess: *const f64,
+    guess_len: i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        let guess = if guess.is_null() {
+            None
+        } else {
+            let len = len_of(guess_len, "guess_len")?;
+            if len != 2 * h.p {
+                return Err(Failure::length(format!(
+                    "guess has {len} values, expected 2p = {} (lambda_n then lambda_t)",
+                    2 * h.p
+                )));
+            }
+            // SAFETY: non-NULL and valid for `len` reads by contract.
+            let g = unsafe { slice_in(guess, len, "guess") }?;
+            if let Some(i) = g.iter().position(|v| !v.is_finite()) {
+                return Err(Failure::new(
+                    fricont_status::FRICONT_ERR_NONFINITE,
+                    format!("guess[{i}] is {}", g[i]),
+                ));
+            }
+            Some(g.to_vec())
+        };
+        if !alpha.is_finite() {
+            return Err(Failure::range(format!("alpha = {alpha} is not finite")));
+        }
+        if h.path.is_none() {
+            let (a0, a1) = h.window.ok_or_else(|| {
+                Failure::order("no alpha window: call fricont_path_set_window before fricont_path_start")
+            })?;
+            let load = h.load.take().ok_or_else(|| {
+                Failure::order("this path failed to initialise earlier; free it and create a new one")
+            })?;
+            let mut opts = PathOptions::window(a0, a1);
+            opts.max_steps = h.max_steps;
+            opts.zero_tol = h.zero_tol;
+            h.path = Some(Path::new(h.problem.clone(), load, opts)?);
+        }
+        h.solutions.clear();
+        let p = h.path.as_mut().expect("created above");
+        p.start(alpha, guess.as_deref())?;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+fn outcome_status(o: &StepOutcome) -> fricont_status {
+    match o {
+        StepOutcome::Transition {
+            bifurcation: true, ..
+        } => fricont_status::FRICONT_BIFURCATION,
+        StepOutcome::Transition { fold: true, .. } => fricont_status::FRICONT_FOLD,
+        StepOutcome::Transition { .. } => fricont_status::FRICONT_TRANSITION,
+        StepOutcome::End(_) => fricont_status::FRICONT_END,
+    }
+}
+
+/// Advances the path to the next transition point, or to its end. The new events (one per
+/// node that changed class, in node order) are appended to the event list.
+///
+/// Returns a positive outcome: `FRICONT_TRANSITION`, `FRICONT_FOLD` (α turns back),
+/// `FRICONT_BIFURCATION` (several pieces continue; the path took the unique
+/// orientation-preserving one; candidates in `fricont_path_branch`), `FRICONT_END` (see
+/// `fricont_path_end_reason`; stepping an ended path returns `FRICONT_END` again, except
+/// after `FRICONT_END_BIFURCATION` and `fricont_path_choose_branch`). Errors:
+/// `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK`,
+/// `FRICONT_ERR_CALLBACK_VALUE` (the path then ends with `FRICONT_END_FAILED`),
+/// `FRICONT_ERR_NUMERICAL`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_step(path: *mut fricont_path) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        let outcome = h.started_mut()?.step()?;
+        Ok(outcome_status(&outcome))
+    })
+}
+
+/// Steps until the path ends. Returns `FRICONT_END` (see `fricont_path_end_reason`) or the
+/// first error of `fricont_path_step`.
+///
+/// # Safety
+/// `path` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_run(path: *mut fricont_path) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        h.started_mut()?.run()?;
+        Ok(fricont_status::FRICONT_END)
+    })
+}
+
+/// Why the path ended: `*reason` receives a `fricont_end_reason` code
+/// (`FRICONT_END_NONE` while it has not ended). `reason` must not be NULL.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `reason` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_end_reason(
+    path: *const fricont_path,
+    reason: *mut i32,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        if reason.is_null() {
+            return Err(Failure::null("reason"));
+        }
+        let code = match h.started()?.end_reason() {
+            None => fricont_end_reason::FRICONT_END_NONE,
+            Some(EndReason::Window) => fricont_end_reason::FRICONT_END_WINDOW,
+            Some(EndReason::MaxSteps) => fricont_end_reason::FRICONT_END_MAX_STEPS,
+            Some(EndReason::ClosedLoop) => fricont_end_reason::FRICONT_END_CLOSED_LOOP,
+            Some(EndReason::Bifurcation) => fricont_end_reason::FRICONT_END_BIFURCATION,
+            Some(EndReason::Failed(_)) => fricont_end_reason::FRICONT_END_FAILED,
+        };
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { reason.write(code as i32) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// The nonzero code returned by the most recent failing load callback on this path
+/// (`*code`; 0 if none failed, or if the callback wrote a NaN/infinity). Works before the
+/// start. `code` must not be NULL.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `code` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_callback_code(
+    path: *const fricont_path,
+    code: *mut i32,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let slot = &h.slot;
+        if code.is_null() {
+            return Err(Failure::null("code"));
+        }
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { code.write(slot.callback_code()) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// The number of events so far (`*count`, not NULL).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `count` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_event_count(
+    path: *const fricont_path,
+    count: *mut i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        if count.is_null() {
+            return Err(Failure::null("count"));
+        }
+        let c = h.started()?.events().len();
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { count.write(c as i64) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies event `k` (0-based, < the event count) into `*out` (not NULL).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (k out of range),
+/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `out` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_event(
+    path: *const fricont_path,
+    k: i64,
+    out: *mut fricont_event,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        if out.is_null() {
+            return Err(Failure::null("out"));
+        }
+        let events = h.started()?.events();
+        let e = &events[index_in(k, events.len(), "event")?];
+        let v = fricont_event {
+            index: e.index as i64,
+            transition: e.transition as i64,
+            alpha: e.alpha,
+            node: e.node as i64,
+            from: class_code(e.from),
+            to: class_code(e.to),
+            fold: e.fold,
+            bifurcation: e.bifurcation,
+            residual: e.state.residual,
+        };
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { out.write(v) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies the full state at event `k` (u, λν, λt, the classes of the piece after the
+/// event, residual) into the caller's buffers described by `*state` (see
+/// `fricont_state`). `state` may be NULL (nothing written).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
+/// `FRICONT_ERR_LENGTH` (a buffer too short), `FRICONT_ERR_ORDER` (not started),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `state` is NULL or an initialised struct whose
+/// non-NULL buffers are valid for their lengths.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_event_state(
+    path: *const fricont_path,
+    k: i64,
+    state: *mut fricont_state,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        let events = h.started()?.events();
+        let e = &events[index_in(k, events.len(), "event")?];
+        h.fill_state(&e.state, state)?;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies the start point (the fixed-α solution the path started from) into `*state`
+/// (see `fricont_state`; may be NULL).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_LENGTH`,
+/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// As `fricont_path_event_state`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_start_state(
+    path: *const fricont_path,
+    state: *mut fricont_state,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        let st = h
+            .started()?
+            .start_state()
+            .ok_or_else(|| Failure::order(NOT_STARTED))?;
+        h.fill_state(st, state)?;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies the current point of the path (the end of the last step) into `*state` (see
+/// `fricont_state`; may be NULL). Costs one back-solve for u; may call the load callback.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_LENGTH`,
+/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK`, `FRICONT_ERR_CALLBACK_VALUE`,
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// As `fricont_path_event_state`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_current(
+    path: *mut fricont_path,
+    state: *mut fricont_state,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        let st = h.started_mut()?.current()?;
+        h.fill_state(&st, state)?;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// The number of traced pieces (`*count`, not NULL); the last one is the current piece.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `count` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_piece_count(
+    path: *const fricont_path,
+    count: *mut i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        if count.is_null() {
+            return Err(Failure::null("count"));
+        }
+        let c = h.started()?.pieces().len();
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { count.write(c as i64) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies piece `k` (0-based) into `*out` (may be NULL) and its class vector into
+/// `classes` (p `fricont_class` codes; may be NULL, else `classes_len` ≥ p).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
+/// `FRICONT_ERR_LENGTH` (`classes_len` < p), `FRICONT_ERR_ORDER` (not started),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `out` is NULL or valid for one write; `classes` is
+/// NULL or valid for `classes_len` writes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_piece(
+    path: *const fricont_path,
+    k: i64,
+    out: *mut fricont_piece,
+    classes: *mut i32,
+    classes_len: i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        let pieces = h.started()?.pieces();
+        let pc = &pieces[index_in(k, pieces.len(), "piece")?];
+        // SAFETY: NULL or valid for `classes_len` writes, by contract.
+        let cl = unsafe { slice_out(classes, classes_len, h.p, "classes") }?;
+        if let Some(c) = cl {
+            for (c, k) in c.iter_mut().zip(&pc.classes) {
+                *c = class_code(*k);
+            }
+        }
+        let v = fricont_piece {
+            alpha_from: pc.alpha_from,
+            alpha_to: pc.alpha_to,
+            direction: pc.direction as i32,
+            orientation: pc.orientation as i32,
+            det_sign: pc.det_sign as i32,
+        };
+        // SAFETY: NULL or valid by contract.
+        unsafe { put(out, v) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// The number of candidate branches at the last transition point (`*count`, not NULL):
+/// 0 unless it was a bifurcation.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `count` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_branch_count(
+    path: *const fricont_path,
+    count: *mut i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        if count.is_null() {
+            return Err(Failure::null("count"));
+        }
+        let c = h.started()?.branches().len();
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { count.write(c as i64) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies candidate branch `k` (0-based) at the last bifurcation into `*out` (may be NULL)
+/// and its class vector into `classes` (may be NULL, else `classes_len` ≥ p).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
+/// `FRICONT_ERR_LENGTH`, `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`,
+/// `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// As `fricont_path_piece`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_branch(
+    path: *const fricont_path,
+    k: i64,
+    out: *mut fricont_branch,
+    classes: *mut i32,
+    classes_len: i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        let branches = h.started()?.branches();
+        let b = &branches[index_in(k, branches.len(), "branch")?];
+        // SAFETY: NULL or valid for `classes_len` writes, by contract.
+        let cl = unsafe { slice_out(classes, classes_len, h.p, "classes") }?;
+        if let Some(c) = cl {
+            for (c, k) in c.iter_mut().zip(&b.classes) {
+                *c = class_code(*k);
+            }
+        }
+        let v = fricont_branch {
+            direction: b.direction as i32,
+            orientation_preserving: b.orientation_preserving,
+        };
+        // SAFETY: NULL or valid by contract.
+        unsafe { put(out, v) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Continues along candidate branch `k` of the last bifurcation instead of the branch the
+/// path took (or after the path stopped with `FRICONT_END_BIFURCATION`); the next
+/// `fricont_path_step` follows it. Only directly after the bifurcation step.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (k out of range),
+/// `FRICONT_ERR_ORDER` (not started, or no bifurcation pending), `FRICONT_ERR_POISONED`,
+/// `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_choose_branch(
+    path: *mut fricont_path,
+    k: i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        let p = h.started_mut()?;
+        let count = p.branches().len();
+        if count == 0 {
+            return Err(Failure::order(
+                "no bifurcation pending: fricont_path_choose_branch is only allowed directly after a bifurcation",
+            ));
+        }
+        let k = index_in(k, count, "branch")?;
+        p.choose_branch(k)?;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Computes every traced solution at `alpha` (one per traced piece whose α-range contains
+/// it: several past a fold; a transition point shared by two pieces once) and keeps them
+/// in the handle; `*count` (not NULL) receives their number (0 if the traced path never
+/// reached `alpha`). Read them with `fricont_path_solution`. Each costs one small solve
+/// on the stored piece and one back-solve for u; may call the load callback. Replaces the
+/// solutions of an earlier call.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (α not finite),
+/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK`, `FRICONT_ERR_CALLBACK_VALUE`,
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `count` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_solutions_at(
+    path: *mut fricont_path,
+    alpha: f64,
+    count: *mut i64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.inner.borrow_mut();
+        if count.is_null() {
+            return Err(Failure::null("count"));
+        }
+        if !alpha.is_finite() {
+            return Err(Failure::range(format!("alpha = {alpha} is not finite")));
+        }
+        h.solutions.clear();
+        let sols = h.started_mut()?.solutions_at(alpha)?;
+        h.solutions = sols;
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { count.write(h.solutions.len() as i64) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies solution `k` (0-based, < the count of the last `fricont_path_solutions_at`):
+/// its origin into `*info` (may be NULL) and its state into `*state` (see
+/// `fricont_state`; may be NULL).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
+/// `FRICONT_ERR_LENGTH`, `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`,
+/// `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `info` is NULL or valid for one write; `state` as in
+/// `fricont_path_event_state`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_solution(
+    path: *const fricont_path,
+    k: i64,
+    info: *mut fricont_solution,
+    state: *mut fricont_state,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.inner.borrow();
+        h.started()?;
+        let s = &h.solutions[index_in(k, h.solutions.len(), "solution")?];
+        h.fill_state(&s.state, state)?;
+        // SAFETY: NULL or valid by contract.
+        unsafe {
+            put(
+                info,
+                fricont_solution {
+                    piece: s.piece as i64,
+                    continuum: s.continuum,
+                },
+            )
+        };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies the message of the most recent failing call on this path handle into `buf`
+/// with `snprintf` semantics (see `fricont_problem_error_message`). Returns the full
+/// length in bytes without the NUL (0 for none or a NULL handle). Works on a poisoned
+/// handle.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `buf` is NULL or valid for `len` bytes of writes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_error_message(
+    path: *const fricont_path,
+    buf: *mut c_char,
+    len: usize,
+) -> usize {
+    super::boundary::run_value(0, || {
+        // SAFETY: NULL or a live handle, by contract.
+        let Some(h) = (unsafe { path.as_ref() }) else {
+            return 0;
+        };
+        // SAFETY: by contract.
+        unsafe { write_message(&h.slot.message(), buf, len) }
+    })
+}

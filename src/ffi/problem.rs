@@ -1,0 +1,494 @@
+//! The problem handle: A, N, T in CSR, friction, gap, r; factorised once and shared.
+
+use std::ffi::c_char;
+use std::sync::{Arc, Mutex};
+
+use super::boundary::{
+    ErrorSlot, Failure, FfiResult, HasSlot, ffi_boundary, handle_ref, len_of, put, slice_in,
+    write_message,
+};
+use super::status::{fricont_status, fricont_storage};
+use crate::problem::{CsrMatrix, Problem, ProblemBuilder, Storage};
+
+/// A sparse matrix in compressed sparse row (CSR) form, as the caller stores it. The
+/// library only reads it during the call that receives it and copies what it needs.
+///
+/// Row `i` (0-based position) holds the entries `row_ptr[i] - index_base ..
+/// row_ptr[i+1] - index_base` (0-based positions in `col_idx` and `values`); the column
+/// numbers in `col_idx` count from `index_base` too. Within a row the columns may come in
+/// any order but must not repeat (duplicates are rejected, not summed).
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+#[allow(non_camel_case_types)]
+pub struct fricont_csr {
+    /// Number of rows, ≥ 0.
+    pub nrows: i64,
+    /// Number of columns, ≥ 0.
+    pub ncols: i64,
+    /// Number of stored entries: the length of `col_idx` and `values`, and
+    /// `row_ptr[nrows] - index_base`.
+    pub nnz: i64,
+    /// `nrows + 1` row pointers, `row_ptr[0] == index_base`, non-decreasing.
+    pub row_ptr: *const i64,
+    /// `nnz` column indices (NULL allowed when `nnz == 0`).
+    pub col_idx: *const i64,
+    /// `nnz` values (NULL allowed when `nnz == 0`), finite.
+    pub values: *const f64,
+    /// 0 (C) or 1 (Fortran, MATLAB).
+    pub index_base: i64,
+}
+
+/// A contact problem: the stiffness A, the contact matrices N and T, friction, gap and
+/// the augmentation parameter r. Opaque.
+///
+/// Created by `fricont_problem_new`, configured by the `fricont_problem_set_*` setters,
+/// factorised by `fricont_problem_build` (or implicitly by the first `fricont_path_new_*`
+/// after a change), freed by `fricont_problem_free`. Every path created from it keeps its
+/// own reference to the factorised data as it was at the path's creation, so the problem
+/// handle may be changed or freed while paths are alive, and any number of paths may use
+/// one problem, from any threads. The problem handle itself is internally locked: its
+/// functions may be called from several threads at once.
+#[allow(non_camel_case_types)]
+pub struct fricont_problem {
+    slot: ErrorSlot,
+    inner: Mutex<ProblemInner>,
+}
+
+struct ProblemInner {
+    n: usize,
+    p: usize,
+    /// The recorded data and settings (taken out and put back by the setters).
+    builder: Option<ProblemBuilder>,
+    /// The factorised problem for the current settings, if built.
+    built: Option<Arc<Problem>>,
+}
+
+impl HasSlot for fricont_problem {
+    fn slot(&self) -> &ErrorSlot {
+        &self.slot
+    }
+}
+
+impl fricont_problem {
+    fn lock(&self) -> std::sync::MutexGuard<'_, ProblemInner> {
+        self.inner.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The factorised problem for the current settings (building it if needed).
+    pub(crate) fn shared(&self) -> FfiResult<(Arc<Problem>, usize, usize)> {
+        let mut inner = self.lock();
+        let problem = inner.build()?;
+        Ok((problem, inner.n, inner.p))
+    }
+}
+
+impl ProblemInner {
+    fn update(&mut self, f: impl FnOnce(ProblemBuilder) -> ProblemBuilder) {
+        let b = self
+            .builder
+            .take()
+            .expect("builder present outside a setter");
+        self.builder = Some(f(b));
+        self.built = None;
+    }
+
+    fn build(&mut self) -> FfiResult<Arc<Problem>> {
+        if let Some(p) = &self.built {
+            return Ok(p.clone());
+        }
+        let b = self
+            .builder
+            .clone()
+            .expect("builder present outside a setter");
+        let p = Arc::new(b.build()?);
+        self.built = Some(p.clone());
+        Ok(p)
+    }
+}
+
+/// Reads a caller's CSR matrix (`name` for messages).
+///
+/// # Safety
+/// `m` is NULL or points to a `fricont_csr` whose arrays are valid for their lengths.
+unsafe fn read_csr(m: *const fricont_csr, name: &str) -> FfiResult<CsrMatrix> {
+    // SAFETY: by this function's contract.
+    let m = unsafe { handle_ref(m, name) }?;
+    let nrows = len_of(m.nrows, &format!("{name}.nrows"))?;
+    let ncols = len_of(m.ncols, &format!("{name}.ncols"))?;
+    let nnz = len_of(m.nnz, &format!("{name}.nnz"))?;
+    // SAFETY: the struct's arrays have the lengths it states (the caller's contract).
+    let (row_ptr, col_idx, values) = unsafe {
+        (
+            slice_in(m.row_ptr, nrows + 1, &format!("{name}.row_ptr"))?,
+            slice_in(m.col_idx, nnz, &format!("{name}.col_idx"))?,
+            slice_in(m.values, nnz, &format!("{name}.values"))?,
+        )
+    };
+    Ok(CsrMatrix::from_raw(
+        name,
+        nrows,
+        ncols,
+        row_ptr,
+        col_idx,
+        values,
+        m.index_base,
+    )?)
+}
+
+fn storage_of(code: i32) -> FfiResult<Storage> {
+    match code {
+        c if c == fricont_storage::FRICONT_STORAGE_FULL as i32 => Ok(Storage::Full),
+        c if c == fricont_storage::FRICONT_STORAGE_LOWER as i32 => Ok(Storage::Lower),
+        c if c == fricont_storage::FRICONT_STORAGE_UPPER as i32 => Ok(Storage::Upper),
+        c => Err(Failure::range(format!(
+            "a_storage = {c} is not a storage code (FRICONT_STORAGE_FULL = 0, _LOWER = 1, _UPPER = 2)"
+        ))),
+    }
+}
+
+/// Creates a problem from the stiffness matrix A and the contact matrices N and T.
+///
+/// * `a`: A (n×n), symmetric positive definite with the Dirichlet dofs eliminated, in
+///   the storage given by `a_storage`. Not NULL.
+/// * `a_storage`: `FRICONT_STORAGE_FULL`, `_LOWER` or `_UPPER` (`fricont_storage`).
+/// * `n`, `t`: N and T (p×n, p ≥ 1, 2p ≤ n): row i gives the outward normal and the
+///   tangential displacement of contact node i, so that `(N u)_i ≤ g_i` is
+///   non-penetration. Not NULL.
+/// * `out`: receives the new handle (NULL on failure). Not NULL.
+///
+/// All arrays are read during the call and copied; the caller keeps ownership. The CSR
+/// structure, the dimensions and finiteness are checked here; symmetry, positive
+/// definiteness of A and the rank of B = [N; T] when the problem is built. Defaults of
+/// the settings: F = 0 (frictionless), gap g = 0, r = 2p / trace(W) (see
+/// `fricont_problem_r`).
+///
+/// Returns `FRICONT_OK`; `FRICONT_ERR_NULL` (a NULL argument or array);
+/// `FRICONT_ERR_LENGTH` (negative sizes, A not square, N or T not p×n, p = 0);
+/// `FRICONT_ERR_RANGE` (unknown `a_storage`); `FRICONT_ERR_CSR` (malformed CSR, index base
+/// not 0/1); `FRICONT_ERR_NONFINITE` (NaN or infinity in a value); `FRICONT_ERR_PANIC`.
+/// The message is in `fricont_last_error_message`.
+///
+/// # Safety
+/// Each pointer is NULL or valid as described; arrays have the lengths the CSR structs
+/// state.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_new(
+    a: *const fricont_csr,
+    a_storage: i32,
+    n: *const fricont_csr,
+    t: *const fricont_csr,
+    out: *mut *mut fricont_problem,
+) -> fricont_status {
+    ffi_boundary!({
+        if out.is_null() {
+            return Err(Failure::null(
+                "out (the fricont_problem ** receiving the handle)",
+            ));
+        }
+        // SAFETY: `out` is a valid pointer by contract; clear it before any failure.
+        unsafe { out.write(std::ptr::null_mut()) };
+        // SAFETY: by this function's contract.
+        let (am, nm, tm) = unsafe { (read_csr(a, "A")?, read_csr(n, "N")?, read_csr(t, "T")?) };
+        let storage = storage_of(a_storage)?;
+        let nd = am.nrows();
+        if am.ncols() != nd {
+            return Err(Failure::length(format!(
+                "A is {}x{}, must be square",
+                nd,
+                am.ncols()
+            )));
+        }
+        let p = nm.nrows();
+        if p == 0 {
+            return Err(Failure::length(
+                "N has 0 rows: there must be at least one contact node",
+            ));
+        }
+        for (name, m) in [("N", &nm), ("T", &tm)] {
+            if m.nrows() != p || m.ncols() != nd {
+                return Err(Failure::length(format!(
+                    "{name} is {}x{}, expected p x n = {p}x{nd} (p from the rows of N, n from A)",
+                    m.nrows(),
+                    m.ncols()
+                )));
+            }
+        }
+        let handle = Box::new(fricont_problem {
+            slot: ErrorSlot::default(),
+            inner: Mutex::new(ProblemInner {
+                n: nd,
+                p,
+                builder: Some(ProblemBuilder::new(am, storage, nm, tm)),
+                built: None,
+            }),
+        });
+        // SAFETY: `out` is valid (checked above).
+        unsafe { out.write(Box::into_raw(handle)) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Frees a problem handle. NULL is a no-op. Paths created from it stay valid (they hold
+/// their own reference to the factorised data). Never use the handle afterwards.
+///
+/// # Safety
+/// `problem` is NULL or a handle from `fricont_problem_new` not freed before.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_free(problem: *mut fricont_problem) {
+    super::boundary::run_value((), || {
+        if !problem.is_null() {
+            // SAFETY: a live handle from `Box::into_raw`, by contract.
+            drop(unsafe { Box::from_raw(problem) });
+        }
+    })
+}
+
+/// Sets the same friction coefficient F (dimensionless, finite, ≥ 0) at every node.
+/// Default 0 (frictionless). A change drops the factorisation: the next build (explicit or
+/// by `fricont_path_new_*`) factorises A again; existing paths are not affected.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (F < 0 or not
+/// finite; the setting is then unchanged), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_set_friction(
+    problem: *mut fricont_problem,
+    friction: f64,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        if !friction.is_finite() || friction < 0.0 {
+            return Err(Failure::range(format!(
+                "friction coefficient F = {friction}, must be finite and >= 0"
+            )));
+        }
+        h.lock().update(|b| b.friction_uniform(friction));
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Sets one friction coefficient per contact node: `friction[i]` (finite, ≥ 0) for node i
+/// (0-based), `len` must equal p. The array is copied. Default: 0 at every node. A change
+/// drops the factorisation as for `fricont_problem_set_friction`.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`, or `friction` with `len > 0`),
+/// `FRICONT_ERR_LENGTH` (`len ≠ p`), `FRICONT_ERR_RANGE` (a value < 0 or not finite; the
+/// message names the node), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `friction` is NULL or valid for `len` reads.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_set_friction_nodes(
+    problem: *mut fricont_problem,
+    friction: *const f64,
+    len: i64,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        let len = len_of(len, "len")?;
+        // SAFETY: by this function's contract.
+        let f = unsafe { slice_in(friction, len, "friction") }?;
+        let mut inner = h.lock();
+        if len != inner.p {
+            return Err(Failure::length(format!(
+                "friction has {len} values, expected p = {}",
+                inner.p
+            )));
+        }
+        if let Some(i) = f.iter().position(|v| !v.is_finite() || *v < 0.0) {
+            return Err(Failure::range(format!(
+                "friction[{i}] (node {}) = {}, must be finite and >= 0",
+                i + 1,
+                f[i]
+            )));
+        }
+        let f = f.to_vec();
+        inner.update(|b| b.friction(f));
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Sets the initial normal gap g (p values, length units of u): node i is in contact when
+/// `(N u)_i = g_i`. `gap` NULL (with any `len`) restores the default g = 0; otherwise
+/// `len` must equal p. The array is copied. A change drops the factorisation as for
+/// `fricont_problem_set_friction`.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_LENGTH` (`len ≠ p`),
+/// `FRICONT_ERR_NONFINITE` (a NaN or infinity; the message names the node),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `gap` is NULL or valid for `len` reads.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_set_gap(
+    problem: *mut fricont_problem,
+    gap: *const f64,
+    len: i64,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        let mut inner = h.lock();
+        let p = inner.p;
+        if gap.is_null() {
+            inner.update(|b| b.gap(vec![0.0; p]));
+            return Ok(fricont_status::FRICONT_OK);
+        }
+        let len = len_of(len, "len")?;
+        if len != p {
+            return Err(Failure::length(format!("gap has {len} values, expected p = {p}")));
+        }
+        // SAFETY: non-NULL and valid for `len` reads by contract.
+        let g = unsafe { slice_in(gap, len, "gap") }?;
+        if let Some(i) = g.iter().position(|v| !v.is_finite()) {
+            return Err(Failure::new(
+                fricont_status::FRICONT_ERR_NONFINITE,
+                format!("gap[{i}] (node {}) is {}", i + 1, g[i]),
+            ));
+        }
+        let g = g.to_vec();
+        inner.update(|b| b.gap(g));
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Sets the augmentation parameter r > 0 (force per length) of the equations H = 0
+/// H1 = A u − f − Nᵀλν − Tᵀλt, H2 = λν − min(λν − r (N u − g), 0),
+/// H3 = λt − P_[−b,b](λt − r T u) with b = max(−F λν, 0).
+/// Solutions, classes and transition points do not depend on r; it scales the
+/// rows H2, H3 and so the reported residuals. Default: r = 2p / trace(W), the reciprocal
+/// of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ. Changing r keeps the
+/// factorisation (no new Cholesky of A).
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (r ≤ 0 or not
+/// finite), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_set_r(
+    problem: *mut fricont_problem,
+    r: f64,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        if !r.is_finite() || r <= 0.0 {
+            return Err(Failure::range(format!("r = {r}, must be finite and > 0")));
+        }
+        let mut inner = h.lock();
+        let b = inner.builder.take().expect("builder present outside a setter");
+        inner.builder = Some(b.r(r));
+        if let Some(p) = inner.built.take() {
+            inner.built = Some(Arc::new(p.with_r(r)?));
+        }
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Validates and factorises the problem now: checks the symmetry of A (full storage),
+/// computes a sparse Cholesky factorisation of A and the Delassus operator
+/// W = B A⁻¹ Bᵀ (one solve with 2p right-hand sides), and checks that W is positive
+/// definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
+/// needed; call it to see data errors early or to time the set-up. A no-op when nothing
+/// changed since the last build.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_NOT_SYMMETRIC`,
+/// `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
+/// the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n),
+/// `FRICONT_ERR_NUMERICAL` (out of memory), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_build(problem: *mut fricont_problem) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        h.shared()?;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// The dimensions: `*n` receives the number of dofs n, `*p` the number of contact nodes
+/// p. Each output pointer may be NULL (not written). Does not build.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_POISONED`,
+/// `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `n`, `p` are NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_dims(
+    problem: *const fricont_problem,
+    n: *mut i64,
+    p: *mut i64,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        let inner = h.lock();
+        // SAFETY: NULL or valid, by contract.
+        unsafe {
+            put(n, inner.n as i64);
+            put(p, inner.p as i64);
+        }
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// The augmentation parameter in use (`*r`) and its data-derived default 2p / trace(W)
+/// (`*default_r`), both force per length. Builds the problem if needed (so it returns the
+/// build's errors too). Each output pointer may be NULL.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), the errors of
+/// `fricont_problem_build`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `r`, `default_r` are NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_r(
+    problem: *mut fricont_problem,
+    r: *mut f64,
+    default_r: *mut f64,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        let (pr, _, _) = h.shared()?;
+        // SAFETY: NULL or valid, by contract.
+        unsafe {
+            put(r, pr.r());
+            put(default_r, pr.default_r());
+        }
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Copies the message of the most recent failing call on this problem handle into `buf`
+/// with `snprintf` semantics (at most `len - 1` bytes and a NUL, cut at a UTF-8 character
+/// boundary; nothing written when `buf` is NULL or `len` is 0). Returns the full message
+/// length in bytes without the NUL (0 if no call on the handle has failed; also 0 for a
+/// NULL handle). Works on a poisoned handle.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `buf` is NULL or valid for `len` bytes of writes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_error_message(
+    problem: *const fricont_problem,
+    buf: *mut c_char,
+    len: usize,
+) -> usize {
+    super::boundary::run_value(0, || {
+        // SAFETY: NULL or a live handle, by contract.
+        let Some(h) = (unsafe { problem.as_ref() }) else {
+            return 0;
+        };
+        // SAFETY: by contract.
+        unsafe { write_message(&h.slot.message(), buf, len) }
+    })
+}

@@ -1,0 +1,135 @@
+//! Small finite-element problems (plane-strain Q1, clamped left edge, p ≤ 5 contact nodes
+//! on the bottom, friction 0.3 to 3) against the brute-force enumeration and walk of
+//! `tests/common`: the same checks as `core_brute.rs`, on realistic stiffness matrices
+//! (κ(A) of a real mesh, strong normal–tangential coupling through A⁻¹) where large
+//! friction gives folds.
+
+mod common;
+
+use std::sync::Arc;
+
+use common::{Brute, check_state, fe_case, lambda_of, samples, trace, vclose};
+use fricont::EndReason;
+
+#[test]
+fn fe_problems_against_enumeration() {
+    let mut walked = 0;
+    let mut total = 0;
+    let mut events = 0;
+    let mut folds = 0;
+    let mut multi = 0;
+    for seed in 0..120u64 {
+        let nx = 3 + (seed % 3) as usize;
+        let ny = 1 + ((seed / 3) % 3) as usize;
+        let friction = [0.3, 1.0, 2.0, 3.0][((seed / 9) % 4) as usize];
+        let case = fe_case(seed, nx, ny, friction);
+        let data = &case.data;
+        total += 1;
+        let ctx = format!(
+            "FE seed {seed} ({nx}x{ny} elements, p = {}, n = {}, F = {friction}, window [{}, {}])",
+            data.p, data.n, case.a0, case.a1
+        );
+        let problem = Arc::new(data.problem());
+        let mut path = trace(problem, data.affine_load(), case.a0, case.a1);
+        let br = Brute::new(data);
+        let start = path.start_state().unwrap().clone();
+        let sl = lambda_of(&start);
+        assert!(
+            br.solutions_at(case.a0)
+                .iter()
+                .any(|(c, l)| *c == start.classes && vclose(l, &sl, 1e-9)),
+            "{ctx}: start"
+        );
+        for e in path.events() {
+            assert!(
+                e.state.residual <= 1e-12,
+                "{ctx}: residual {:e}",
+                e.state.residual
+            );
+            check_state(data, &data.force(e.alpha), &e.state, 1e-9)
+                .unwrap_or_else(|m| panic!("{ctx}: event {}: {m}", e.index));
+        }
+        let walk = br.walk(case.a0, case.a1, &sl);
+        if let Some(w) = &walk {
+            walked += 1;
+            let ev = path.events();
+            let exp: Vec<String> = w
+                .events
+                .iter()
+                .map(|e| {
+                    format!(
+                        "{:.15} node {} {} -> {} fold {}",
+                        e.phi, e.node, e.from, e.to, e.fold
+                    )
+                })
+                .collect();
+            let got: Vec<String> = ev
+                .iter()
+                .map(|e| {
+                    format!(
+                        "{:.15} node {} {} -> {} fold {}",
+                        e.alpha, e.node, e.from, e.to, e.fold
+                    )
+                })
+                .collect();
+            assert_eq!(
+                ev.len(),
+                w.events.len(),
+                "{ctx}: events\n expected {exp:#?}\n got {got:#?}"
+            );
+            for (e, x) in ev.iter().zip(&w.events) {
+                assert!(
+                    (e.alpha - x.phi).abs() <= 1e-12 * x.phi.abs().max(1.0),
+                    "{ctx}: event {} α = {:.17e}, brute force {:.17e}",
+                    e.index,
+                    e.alpha,
+                    x.phi
+                );
+                assert_eq!(
+                    (e.node, e.from, e.to, e.fold),
+                    (x.node, x.from, x.to, x.fold),
+                    "{ctx}: event {}\n expected {exp:#?}\n got {got:#?}",
+                    e.index
+                );
+                folds += e.fold as usize;
+            }
+            events += ev.len();
+            let want_end = if w.closed {
+                EndReason::ClosedLoop
+            } else {
+                EndReason::Window
+            };
+            assert_eq!(path.end_reason(), Some(&want_end), "{ctx}");
+        }
+        for alpha in samples(&case, &br, 8, 1e-6) {
+            let sols = path.solutions_at(alpha).unwrap();
+            let all = br.solutions_at(alpha);
+            if all.len() > 1 {
+                multi += 1;
+            }
+            for s in &sols {
+                let l = lambda_of(&s.state);
+                assert!(
+                    all.iter()
+                        .any(|(c, b)| *c == s.state.classes && vclose(b, &l, 1e-9)),
+                    "{ctx}: solutions_at({alpha}) not a solution: {:?}",
+                    s.state
+                );
+            }
+            if let Some(w) = &walk {
+                let want = w.solutions_at(&br, alpha);
+                assert_eq!(sols.len(), want.len(), "{ctx}: solutions_at({alpha})");
+                for x in &want {
+                    assert!(
+                        sols.iter().any(|s| vclose(&lambda_of(&s.state), x, 1e-9)),
+                        "{ctx}: α = {alpha}: missing {x:?}"
+                    );
+                }
+            }
+        }
+    }
+    eprintln!(
+        "FE: {walked}/{total} walks compared, {events} events, {folds} folds, {multi} samples with several solutions"
+    );
+    assert!(walked * 4 >= total * 3, "too few generic cases");
+}

@@ -1,0 +1,209 @@
+//! Degenerate transitions and non-smooth bifurcations on random mirror-symmetric problems
+//! (SPEC §3: "a symmetric body under a symmetric load switches mirrored nodes at the same
+//! α, and a node at the axis of symmetry touches down with dt = 0 exactly, so it enters
+//! ST, not S±").
+//!
+//! Every transition point the library reports is checked against the independent
+//! enumeration of `tests/common`: the pieces whose closure contains the point, less the
+//! piece the path came from, are exactly the continuations. So a transition not flagged
+//! as a bifurcation must have exactly one such piece, the one the path took; one flagged
+//! as a bifurcation must offer exactly those pieces in `branches()`. After a bifurcation
+//! where the library stops (`EndReason::Bifurcation`), `choose_branch` is exercised.
+//! While the traced solution is symmetric, mirrored nodes switch together (same α, same
+//! classes, one event per node in node order) and the centre node is never in slip.
+
+mod common;
+
+use std::collections::BTreeSet;
+use std::sync::Arc;
+
+use common::{
+    Brute, Case, check_state, class_equations_hold, lambda_of, samples, symmetric_case, vclose,
+};
+use fricont::{Class, EndReason, Path, PathOptions, StepOutcome};
+
+#[derive(Default, Debug)]
+struct Stats {
+    transitions: usize,
+    degenerate: usize,
+    bifurcations: usize,
+    stopped: usize,
+    centre_touchdowns: usize,
+}
+
+fn set(v: &[Vec<Class>]) -> BTreeSet<Vec<Class>> {
+    v.iter().cloned().collect()
+}
+
+fn check_case(case: &Case, st: &mut Stats) {
+    let data = &case.data;
+    let p = data.p;
+    let br = Brute::new(data);
+    let ctx = format!(
+        "symmetric seed {} (p = {p}, F = {:?}, window [{}, {}])",
+        case.seed, data.friction, case.a0, case.a1
+    );
+    let mut path = Path::new(
+        Arc::new(data.problem()),
+        data.affine_load(),
+        PathOptions::window(case.a0, case.a1),
+    )
+    .unwrap();
+    path.start(case.a0, None)
+        .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
+    let mut prev = path.start_state().unwrap().classes.clone();
+    for _ in 0..200 {
+        let out = path.step().unwrap_or_else(|e| panic!("{ctx}: step: {e}"));
+        let (range, bif, offered) = match out {
+            StepOutcome::Transition {
+                events,
+                bifurcation,
+                ..
+            } => (events, bifurcation, path.branches().to_vec()),
+            StepOutcome::End(EndReason::Bifurcation) => {
+                st.stopped += 1;
+                let offered = path.branches().to_vec();
+                assert!(
+                    offered.len() >= 2,
+                    "{ctx}: stopped at a bifurcation with {} branches",
+                    offered.len()
+                );
+                let before = path.events().len();
+                path.choose_branch(0)
+                    .unwrap_or_else(|e| panic!("{ctx}: choose_branch(0): {e}"));
+                assert_eq!(
+                    path.pieces().last().unwrap().classes,
+                    offered[0].classes,
+                    "{ctx}: chosen branch"
+                );
+                (before..path.events().len(), true, offered)
+            }
+            StepOutcome::End(_) => break,
+        };
+        st.transitions += 1;
+        let ev = &path.events()[range.clone()];
+        assert!(!ev.is_empty(), "{ctx}: a transition without events");
+        let e0 = &ev[0];
+        for e in ev {
+            assert_eq!(
+                (e.alpha, e.transition),
+                (e0.alpha, e0.transition),
+                "{ctx}: one transition, one α"
+            );
+            assert_eq!(e.bifurcation, bif, "{ctx}");
+        }
+        assert!(
+            ev.windows(2).all(|w| w[0].node < w[1].node),
+            "{ctx}: events not in node order: {ev:#?}"
+        );
+        if ev.len() > 1 {
+            st.degenerate += 1;
+        }
+        let new = path.pieces().last().unwrap().classes.clone();
+        for e in ev {
+            assert_eq!(
+                (prev[e.node], new[e.node]),
+                (e.from, e.to),
+                "{ctx}: event classes"
+            );
+            class_equations_hold(data, &e.state, e.node, e.from, 1e-9)
+                .unwrap_or_else(|m| panic!("{ctx}: {m}"));
+            class_equations_hold(data, &e.state, e.node, e.to, 1e-9)
+                .unwrap_or_else(|m| panic!("{ctx}: {m}"));
+            assert!(
+                e.state.residual <= 1e-12,
+                "{ctx}: residual {:e}",
+                e.state.residual
+            );
+        }
+        for i in 0..p {
+            if ev.iter().all(|e| e.node != i) {
+                assert_eq!(
+                    prev[i], new[i],
+                    "{ctx}: node {i} changed class without an event"
+                );
+            }
+        }
+        // the continuations by enumeration
+        let lam = lambda_of(&e0.state);
+        let mut expected = br.incident(e0.alpha, &lam, 1e-9);
+        expected.retain(|c| *c != prev);
+        if bif {
+            st.bifurcations += 1;
+            let got: Vec<Vec<Class>> = offered.iter().map(|b| b.classes.clone()).collect();
+            assert_eq!(
+                set(&got),
+                set(&expected),
+                "{ctx}: bifurcation at α = {}: branches",
+                e0.alpha
+            );
+            assert!(expected.contains(&new), "{ctx}");
+        } else {
+            assert_eq!(
+                expected,
+                vec![new.clone()],
+                "{ctx}: transition at α = {} (from {prev:?})",
+                e0.alpha
+            );
+        }
+        // symmetry while the solution is symmetric
+        let s = &e0.state;
+        let symmetric = (s.lambda_n[0] - s.lambda_n[1]).abs() <= 1e-9 * (1.0 + s.lambda_n[0].abs())
+            && (s.lambda_t[0] - s.lambda_t[1]).abs() <= 1e-9 * (1.0 + s.lambda_t[0].abs());
+        if symmetric && !bif && prev[0] == prev[1] {
+            assert_eq!(
+                new[0], new[1],
+                "{ctx}: mirrored nodes split at a non-bifurcation point α = {}",
+                e0.alpha
+            );
+            if p == 3 {
+                assert!(
+                    !matches!(new[2], Class::SlipPlus | Class::SlipMinus),
+                    "{ctx}: centre node slips: {new:?} at α = {}",
+                    e0.alpha
+                );
+                if ev.iter().any(|e| e.node == 2 && e.from == Class::Open) {
+                    st.centre_touchdowns += 1;
+                }
+            }
+        }
+        prev = new;
+    }
+    // solutions at sampled α are solutions (containment in the enumeration)
+    for alpha in samples(case, &br, 6, 1e-6) {
+        let all = br.solutions_at(alpha);
+        for s in path.solutions_at(alpha).unwrap() {
+            let l = lambda_of(&s.state);
+            assert!(
+                all.iter()
+                    .any(|(c, b)| *c == s.state.classes && vclose(b, &l, 1e-9)),
+                "{ctx}: solutions_at({alpha}) gave {:?}, not a solution",
+                s.state
+            );
+            check_state(data, &data.force(alpha), &s.state, 1e-9).unwrap();
+        }
+    }
+}
+
+#[test]
+fn mirror_pairs() {
+    let mut st = Stats::default();
+    for seed in 0..300u64 {
+        check_case(&symmetric_case(seed, false), &mut st);
+    }
+    eprintln!("{st:?}");
+    assert!(st.degenerate >= 150 && st.bifurcations >= 10, "{st:?}");
+}
+
+#[test]
+fn mirror_pairs_with_centre_node() {
+    let mut st = Stats::default();
+    for seed in 1000..1300u64 {
+        check_case(&symmetric_case(seed, true), &mut st);
+    }
+    eprintln!("{st:?}");
+    assert!(
+        st.degenerate >= 150 && st.centre_touchdowns >= 20 && st.bifurcations >= 10,
+        "{st:?}"
+    );
+}
