@@ -1,0 +1,13 @@
+//! Runs the founding paper's case study: `cargo run --release --example case_study -- OUT`
+//! (the CLI's `fricont case-study --out OUT` does the same).
+fn main() {
+    let out = std::env::args().nth(1).unwrap_or_else(|| "out".into());
+    let opts = fricont::casestudy::CaseStudyOptions::new(out);
+    match fricont::casestudy::run(&opts) {
+        Ok(r) => print!("{}", r.text()),
+        Err(e) => {
+            eprintln!("case study failed: {e}");
+            std::process::exit(1);
+        }
+    }
+}
