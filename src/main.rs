@@ -37,12 +37,63 @@ struct Cli {
 enum Command {
     /// Trace the solution path of a problem directory (SPEC §7 exchange format).
     Trace(TraceArgs),
-    // --- Subcommands of the case study (issue 4), wired by the lead at merge time: ---
-    // GenRect(GenRectArgs)      -> fricont::generator::generate(&RectSpec)?.write_dir(&dir)
-    //                              (the module is `generator`: `gen` is a keyword in 2024)
-    // CaseStudy(CaseStudyArgs)  -> fricont::casestudy::run(&CaseStudyOptions::new(out))
-    // Add the variants here and their arms in `main` below (marked likewise). Map a bad
-    // spec or output directory to `input(..)` (exit 2), other failures to `runtime(..)`.
+    /// Write a rectangle problem (Q1 plane strain, left side clamped, bottom on a rigid
+    /// foundation) in the exchange format. Defaults: the case study (31 × 22 nodes).
+    GenRect(GenRectArgs),
+    /// Run the founding paper's case study: transition table, figures, path as CSV/JSON.
+    CaseStudy(CaseStudyArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct GenRectArgs {
+    /// Output problem directory (created).
+    dir: PathBuf,
+    /// Start from the sample's "press-shear" load instead of the case study's load.
+    #[arg(long)]
+    press_shear: bool,
+    /// Nodes along x (the bottom side has nx − 1 contact nodes).
+    #[arg(long)]
+    nx: Option<usize>,
+    /// Nodes along y.
+    #[arg(long)]
+    ny: Option<usize>,
+    /// Side length along x.
+    #[arg(long)]
+    lx: Option<f64>,
+    /// Side length along y.
+    #[arg(long)]
+    ly: Option<f64>,
+    /// Young's modulus.
+    #[arg(long)]
+    e: Option<f64>,
+    /// Poisson's ratio.
+    #[arg(long)]
+    nu: Option<f64>,
+    /// Friction coefficient of every contact node.
+    #[arg(long)]
+    friction: Option<f64>,
+    /// Uniform initial gap.
+    #[arg(long)]
+    gap: Option<f64>,
+    /// Tractions of f0, repeatable: SIDE:TX,TY or SIDE:TX,TY:TX2,TY2 (replaces the default).
+    #[arg(long, allow_negative_numbers = true)]
+    load0: Vec<String>,
+    /// Tractions of f1 (per unit α), same form (replaces the default).
+    #[arg(long, allow_negative_numbers = true)]
+    load1: Vec<String>,
+    /// Start of the α window written to meta.json.
+    #[arg(long, allow_negative_numbers = true)]
+    alpha_start: Option<f64>,
+    /// End of the α window written to meta.json.
+    #[arg(long, allow_negative_numbers = true)]
+    alpha_end: Option<f64>,
+}
+
+#[derive(clap::Args, Debug)]
+struct CaseStudyArgs {
+    /// Output directory (created): table, figures (SVG), path (CSV, JSON), problem files.
+    #[arg(long, default_value = "out")]
+    out: PathBuf,
 }
 
 #[derive(clap::Args, Debug)]
@@ -150,7 +201,8 @@ fn main() -> ExitCode {
     }
     let result = std::panic::catch_unwind(|| match &cli.command {
         Command::Trace(a) => trace(a),
-        // --- case-study subcommands (issue 4): arms go here. ---
+        Command::GenRect(a) => gen_rect(a),
+        Command::CaseStudy(a) => case_study(a),
     })
     .unwrap_or_else(|_| {
         let m = panic_msg.lock().map(|m| m.clone()).unwrap_or_default();
@@ -167,4 +219,48 @@ fn main() -> ExitCode {
             ExitCode::from(f.status)
         }
     }
+}
+
+fn gen_rect(a: &GenRectArgs) -> Result<(), Failure> {
+    use fricont::generator::{RectSpec, Traction};
+    let mut spec = if a.press_shear {
+        RectSpec::press_shear()
+    } else {
+        RectSpec::default()
+    };
+    macro_rules! set {
+        ($($f:ident),*) => { $(if let Some(v) = a.$f { spec.$f = v; })* };
+    }
+    set!(nx, ny, lx, ly, e, nu, friction, gap, alpha_start, alpha_end);
+    let parse = |v: &[String]| -> Result<Vec<Traction>, Failure> {
+        v.iter()
+            .map(|t| t.parse::<Traction>().map_err(input))
+            .collect()
+    };
+    if !a.load0.is_empty() {
+        spec.load0 = parse(&a.load0)?;
+        spec.load_name = "custom".into();
+    }
+    if !a.load1.is_empty() {
+        spec.load1 = parse(&a.load1)?;
+        spec.load_name = "custom".into();
+    }
+    let data = fricont::generator::generate(&spec).map_err(input)?;
+    data.write_dir(&a.dir).map_err(input)?;
+    println!(
+        "wrote {} ({}: n = {}, p = {}, F = {})",
+        a.dir.display(),
+        spec.mesh_description(),
+        spec.n(),
+        spec.p(),
+        spec.friction
+    );
+    Ok(())
+}
+
+fn case_study(a: &CaseStudyArgs) -> Result<(), Failure> {
+    let opts = fricont::casestudy::CaseStudyOptions::new(a.out.clone());
+    let report = fricont::casestudy::run(&opts).map_err(runtime)?;
+    print!("{}", report.text());
+    Ok(())
 }
