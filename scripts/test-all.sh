@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 need_pkgs=()
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
-for p in libsuitesparse-dev valgrind pkg-config cmake gfortran octave liboctave-dev; do
+for p in libsuitesparse-dev valgrind pkg-config cmake patchelf gfortran octave liboctave-dev; do
   have_pkg "$p" || need_pkgs+=("$p")
 done
 if ((${#need_pkgs[@]})); then
@@ -27,9 +27,7 @@ echo "== cargo build --release (library, CLI)"
 cargo build --release -q
 
 for suite in c-tests/run.sh cpp-tests/run.sh fortran/run.sh matlab/run.sh tests-install/run.sh; do
-  if [ -f "$suite" ]; then
-    echo "== $suite"
-    bash "$suite"
-  fi
+  echo "== $suite"
+  bash "$suite"
 done
 echo "== all test suites passed"

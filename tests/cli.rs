@@ -463,6 +463,7 @@ fn max_steps_stops_the_path() {
 ///   dt = (−½(1 + λν) + α + 3 λν)/D = (4.5 − 1.5 α)/D > 0 ⇔ α < 3;
 /// - stick: λ = −f = (−1, −α), guard |α| < F·1 = 3;
 /// - slip−: λt = −F λν ⇒ λν = −s/(1 + ½F) = −(1 − α/2)/2.5, dt = (0.9 + 0.3 α)/D < 0 ⇔ α < −3.
+///
 /// Traced from α = 4 toward −4: open (α decreasing) until α = 2 where contact closes with
 /// dt > 0 into slip+, which exists only for α ∈ (2, 3): α turns back (fold 1); slip+ → stick
 /// at α = 3 where dt reaches 0, and stick exists for α < 3: α turns back again (fold 2);
