@@ -1005,10 +1005,13 @@ fricont_status fricont_path_event_count(const struct fricont_path *path,
                                         int64_t *count);
 
 /**
- * Copies event `k` (0-based, < the event count) into `*out` (not NULL).
+ * Copies event `k` (0-based, < the event count) into `*out` (not NULL). The event's
+ * `residual` is computed here: one back-solve with the factor of A (the tracer itself
+ * does no work proportional to n per event).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (k out of range),
- * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK` (a general load callback
+ * failed when f(α) was evaluated), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
  *
  * # Safety
  * `path` is NULL or a live handle; `out` is NULL or valid for one write.
@@ -1020,11 +1023,13 @@ fricont_status fricont_path_event(const struct fricont_path *path,
 /**
  * Copies the full state at event `k` (u, λν, λt, the classes of the piece after the
  * event, residual) into the caller's buffers described by `*state` (see
- * `fricont_state`). `state` may be NULL (nothing written).
+ * `fricont_state`). `state` may be NULL (nothing written). Costs one back-solve with the
+ * factor of A.
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
  * `FRICONT_ERR_LENGTH` (a buffer too short), `FRICONT_ERR_ORDER` (not started),
- * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_CALLBACK` (a general load callback failed), `FRICONT_ERR_POISONED`,
+ * `FRICONT_ERR_PANIC`.
  *
  * # Safety
  * `path` is NULL or a live handle; `state` is NULL or an initialised struct whose

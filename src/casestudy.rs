@@ -1185,8 +1185,8 @@ fn marked_points(path: &Path) -> Vec<MarkedPoint> {
         .map(|e| MarkedPoint {
             transition: e.transition + 1,
             alpha: e.alpha,
-            lambda_n: e.state.lambda_n.clone(),
-            lambda_t: e.state.lambda_t.clone(),
+            lambda_n: e.lambda_n.clone(),
+            lambda_t: e.lambda_t.clone(),
             fold: e.fold,
             node: e.node,
         })
@@ -1239,18 +1239,17 @@ fn path_json(path: &mut Path, case: &CaseData, setup_s: f64, trace_s: f64) -> Re
             "lambda_n": d.lambda_n, "lambda_t": d.lambda_t, "u_n": d.u_n, "u_t": d.u_t,
         })
     };
-    let events: Vec<Value> = path
-        .events()
-        .iter()
-        .map(|e| {
-            json!({
-                "index": e.index + 1, "transition": e.transition + 1, "alpha": e.alpha,
-                "node": e.node + 1, "from": e.from.name(), "to": e.to.name(),
-                "fold": e.fold, "bifurcation": e.bifurcation, "residual": e.state.residual,
-                "state": vertex(&e.state),
-            })
-        })
-        .collect();
+    let list = path.events().to_vec();
+    let mut events: Vec<Value> = Vec::with_capacity(list.len());
+    for e in &list {
+        let st = path.event_state(e.index)?;
+        events.push(json!({
+            "index": e.index + 1, "transition": e.transition + 1, "alpha": e.alpha,
+            "node": e.node + 1, "from": e.from.name(), "to": e.to.name(),
+            "fold": e.fold, "bifurcation": e.bifurcation, "residual": st.residual,
+            "state": vertex(&st),
+        }));
+    }
     let pieces: Vec<Value> = path
         .pieces()
         .iter()
@@ -1307,12 +1306,12 @@ fn path_csv(path: &mut Path, case: &CaseData) -> Result<String> {
         row("start", 0, st);
     }
     let mut last = None;
-    for e in path.events() {
+    for e in path.events().to_vec() {
         if last == Some(e.transition) {
             continue;
         }
         last = Some(e.transition);
-        row("transition", e.transition + 1, &e.state);
+        row("transition", e.transition + 1, &path.event_state(e.index)?);
     }
     let cur = path.current()?;
     row("end", 0, &cur);

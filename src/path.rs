@@ -95,6 +95,10 @@ pub struct State {
 }
 
 /// One node changing class at a transition point.
+///
+/// An event carries the contact forces at the point (2p numbers); the full state (u and
+/// the residual) costs one back-solve with the factor of A and is computed on request by
+/// [`Path::event_state`], so that tracing costs nothing proportional to n per event.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Event {
     /// 0-based position in [`Path::events`].
@@ -113,8 +117,12 @@ pub struct Event {
     pub fold: bool,
     /// More than one neighbouring piece continues the path here.
     pub bifurcation: bool,
-    /// Full state at the transition point (classes: those of the piece after).
-    pub state: State,
+    /// Normal contact forces at the transition point (p), ≤ 0.
+    pub lambda_n: Vec<f64>,
+    /// Tangential contact forces at the transition point (p).
+    pub lambda_t: Vec<f64>,
+    /// Classes of all nodes on the piece after the transition.
+    pub classes: Vec<Class>,
 }
 
 /// A candidate continuation at a transition point.
@@ -1151,9 +1159,9 @@ impl Path {
             sign(cand.t[m])
         };
         let fold = dir != 0 && pend.last_dir != 0 && dir != pend.last_dir;
-        let state = self.state(&pt.lam, pt.alpha, &cand.classes)?;
         let scale = self.force_scale(&pt);
         let a_s = self.alpha_scale();
+        let p = self.problem.p();
         let tr = self.trace.as_mut().expect("started");
         tr.events.truncate(pend.events_start);
         tr.pieces.truncate(pend.pieces_len);
@@ -1170,7 +1178,9 @@ impl Path {
                     to: cand.classes[i],
                     fold,
                     bifurcation: pend.bifurcation,
-                    state: state.clone(),
+                    lambda_n: pt.lam[..p].to_vec(),
+                    lambda_t: pt.lam[p..].to_vec(),
+                    classes: cand.classes.clone(),
                 });
             }
         }
@@ -1260,6 +1270,21 @@ impl Path {
             .as_ref()
             .map(|t| t.events.as_slice())
             .unwrap_or(&[])
+    }
+
+    /// The full state at event `k`: u by one back-solve of `f(α) + Bᵀλ`, and the residual.
+    /// Errors: not started, `k` out of range, load failure.
+    pub fn event_state(&mut self, k: usize) -> Result<State> {
+        let tr = self.trace_ref()?;
+        let e = tr.events.get(k).ok_or_else(|| {
+            Error::Usage(format!(
+                "event {k} does not exist ({} events)",
+                tr.events.len()
+            ))
+        })?;
+        let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
+        let (alpha, classes) = (e.alpha, e.classes.clone());
+        self.state(&lam, alpha, &classes)
     }
 
     /// The pieces so far (the last one is the current piece; empty before the start).

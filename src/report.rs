@@ -258,10 +258,10 @@ impl PathReport {
             lambda_n: s.lambda_n.clone(),
             lambda_t: s.lambda_t.clone(),
         });
-        let events: Vec<EventReport> = path
-            .events()
-            .iter()
-            .map(|e: &Event| EventReport {
+        let list: Vec<Event> = path.events().to_vec();
+        let mut events: Vec<EventReport> = Vec::with_capacity(list.len());
+        for e in &list {
+            events.push(EventReport {
                 index: e.index + 1,
                 alpha: e.alpha,
                 node: e.node + 1,
@@ -269,12 +269,14 @@ impl PathReport {
                 to: e.to.name(),
                 fold: e.fold,
                 bifurcation: e.bifurcation,
-                residual: e.state.residual,
+                // the load was evaluated at this α while tracing; NaN (null in JSON) only
+                // if a general load callback now refuses it
+                residual: path.event_state(e.index).map_or(f64::NAN, |s| s.residual),
                 transition: e.transition + 1,
-                lambda_n: e.state.lambda_n.get(e.node).copied(),
-                lambda_t: e.state.lambda_t.get(e.node).copied(),
-            })
-            .collect();
+                lambda_n: e.lambda_n.get(e.node).copied(),
+                lambda_t: e.lambda_t.get(e.node).copied(),
+            });
+        }
         let residual_max = start
             .iter()
             .map(|s| s.residual)

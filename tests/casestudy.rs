@@ -183,22 +183,24 @@ fn printed_transitions_agree_with_tracing_the_files_read_back() {
     assert_eq!(written, report.table);
     let printed = parse_table(&report.table);
     assert_eq!(printed.len(), report.transitions.len());
-    let (case, path) = trace_dir(&out.join("problem"));
+    let (case, mut path) = trace_dir(&out.join("problem"));
     assert_same_events(&printed, &path, "case study");
     assert_eq!(case.n(), 1320);
     assert_eq!(case.p(), 30);
-    for e in path.events() {
-        check_state(&case, &e.state, &format!("event {}", e.index + 1));
+    for k in 0..path.events().len() {
+        let st = path.event_state(k).unwrap();
+        check_state(&case, &st, &format!("event {}", k + 1));
     }
     // the high-friction variant too
     let fold = report.fold.as_ref().unwrap();
     let hf = out.join("high-friction");
     let written = std::fs::read_to_string(hf.join("transitions.txt")).unwrap();
     assert_eq!(written, fold.table);
-    let (case, path) = trace_dir(&hf.join("problem"));
+    let (case, mut path) = trace_dir(&hf.join("problem"));
     assert_same_events(&parse_table(&fold.table), &path, "high-friction variant");
-    for e in path.events() {
-        check_state(&case, &e.state, &format!("variant event {}", e.index + 1));
+    for k in 0..path.events().len() {
+        let st = path.event_state(k).unwrap();
+        check_state(&case, &st, &format!("variant event {}", k + 1));
     }
     // the figures and data files are where the report says
     for f in [

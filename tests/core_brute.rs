@@ -62,7 +62,7 @@ fn random_problems_against_enumeration() {
         );
 
         // Every event state solves the problem.
-        for e in path.events() {
+        for e in &common::events_with_state(&mut path) {
             assert!(
                 e.state.residual <= 1e-12,
                 "{ctx}: event {} residual {:e}",

@@ -10,7 +10,9 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{Brute, Case, Rng, fold_problem, lambda_of, random_case, samples, trace, vclose};
+use common::{
+    Brute, Case, Rng, fold_problem, lambda_ev, lambda_of, random_case, samples, trace, vclose,
+};
 use fricont::{Path, PathOptions};
 use nalgebra::DVector;
 
@@ -102,13 +104,13 @@ fn check_case(case: &Case, nsamples: usize) -> usize {
     }
     // Solves exactly at transition points reproduce the event state when the solution
     // there is unique (unique on both sides).
-    for e in path.events() {
+    for e in &common::events_with_state(&mut path) {
         if br.solutions_at(e.alpha - 1e-7).len() == 1 && br.solutions_at(e.alpha + 1e-7).len() == 1
         {
             let p = fresh(case, &problem, e.alpha, None);
             let st = p.start_state().unwrap();
             assert!(
-                vclose(&lambda_of(st), &lambda_of(&e.state), 1e-8),
+                vclose(&lambda_of(st), &lambda_ev(e), 1e-8),
                 "{ctx}: solve at event {} α = {}: {st:?} vs {:?}",
                 e.index,
                 e.alpha,

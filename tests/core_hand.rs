@@ -21,7 +21,9 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{Brute, Data, check_state, close, lambda_of, mirror_pair, one_node, trace, vclose};
+use common::{
+    Brute, Data, check_state, close, lambda_ev, lambda_of, mirror_pair, one_node, trace, vclose,
+};
 use fricont::{Class, EndReason};
 use nalgebra::DVector;
 
@@ -32,8 +34,8 @@ fn lam(v: &[f64]) -> DVector<f64> {
 }
 
 /// Every event's state solves the problem (independent check) and has a small residual.
-fn check_events(data: &Data, path: &fricont::Path) {
-    for e in path.events() {
+fn check_events(data: &Data, path: &mut fricont::Path) {
+    for e in &common::events_with_state(path) {
         assert!(
             e.state.residual <= TOL,
             "event {} residual {:e}",
@@ -107,13 +109,13 @@ fn two_folds_three_solutions() {
     // λ at the events, by hand: (0, 0), (−2, −4), (−0.4, 0.8).
     for (e, l) in ev.iter().zip([[0.0, 0.0], [-2.0, -4.0], [-0.4, 0.8]]) {
         assert!(
-            vclose(&lambda_of(&e.state), &lam(&l), TOL),
+            vclose(&lambda_ev(e), &lam(&l), TOL),
             "λ at event {}: {:?}",
             e.index,
-            e.state
+            e
         );
     }
-    check_events(&data, &path);
+    check_events(&data, &mut path);
 
     let dirs: Vec<i8> = path.pieces().iter().map(|pc| pc.direction).collect();
     assert_eq!(dirs, vec![1, -1, 1, 1]);
@@ -214,9 +216,9 @@ fn vertical_piece_continuum() {
             (e.node, e.from, e.to, e.fold, e.bifurcation),
             (0, from, to, false, false)
         );
-        assert!(vclose(&lambda_of(&e.state), &lam(&l), TOL), "{:?}", e.state);
+        assert!(vclose(&lambda_ev(e), &lam(&l), TOL), "{e:?}");
     }
-    check_events(&data, &path);
+    check_events(&data, &mut path);
 
     let pcs = path.pieces();
     assert_eq!(pcs.len(), 3, "{pcs:#?}");
@@ -349,11 +351,11 @@ fn degenerate_symmetric_transition() {
     assert_eq!(ev[0].alpha, ev[1].alpha);
     assert_eq!(ev[2].alpha, ev[3].alpha);
     assert!(vclose(
-        &lambda_of(&ev[3].state),
+        &lambda_ev(&ev[3]),
         &lam(&[-2.0, -2.0, -1.0, -1.0]),
         TOL
     ));
-    check_events(&data, &path);
+    check_events(&data, &mut path);
     let classes: Vec<Vec<Class>> = path.pieces().iter().map(|p| p.classes.clone()).collect();
     assert_eq!(
         classes,
@@ -413,7 +415,7 @@ fn touch_down_with_zero_slip_enters_stick() {
         (ev[0].node, ev[0].from, ev[0].to, ev[0].fold),
         (0, Class::Open, Class::Stick, false)
     );
-    check_events(&data, &path);
+    check_events(&data, &mut path);
     let sols = path.solutions_at(0.6).unwrap();
     assert_eq!(sols.len(), 1);
     assert!(vclose(&lambda_of(&sols[0].state), &lam(&[-0.9, -0.3]), TOL));

@@ -13,7 +13,7 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{Brute, Data, close, fold_problem, lambda_of, random_case, trace};
+use common::{Brute, Data, close, fold_problem, lambda_ev, lambda_of, random_case, trace};
 use fricont::load::{LoadFailure, VectorFn};
 use fricont::{Class, Load, Problem};
 
@@ -111,9 +111,9 @@ fn check_reparam(
     }
     let (b0, b1) = (phi_inv(a0), phi_inv(a1));
     for (name, load) in loads(data) {
-        let path = trace(problem.clone(), load, b0, b1);
+        let mut path = trace(problem.clone(), load, b0, b1);
         assert_eq!(path.end_reason(), affine.end_reason(), "{ctx}, {name}");
-        let ev = path.events();
+        let ev = common::events_with_state(&mut path);
         assert_eq!(ev.len(), expected.len(), "{ctx}, {name}: events {ev:#?}");
         for (k, (e, x)) in ev.iter().zip(expected).enumerate() {
             let want = phi_inv(x.0);
@@ -140,10 +140,10 @@ fn check_reparam(
                 e.state.residual
             );
             // the state equals the affine state at α = φ(β)
-            let a = &affine.events()[k].state;
-            let d = (lambda_of(&e.state) - lambda_of(a)).amax();
+            let a = &affine.events()[k];
+            let d = (lambda_ev(e) - lambda_ev(a)).amax();
             assert!(
-                d <= 1e-9 * 1f64.max(lambda_of(a).amax()),
+                d <= 1e-9 * 1f64.max(lambda_ev(a).amax()),
                 "{ctx}, {name}: λ differs by {d:e}"
             );
         }

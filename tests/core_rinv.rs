@@ -9,7 +9,8 @@ mod common;
 use std::sync::Arc;
 
 use common::{
-    Brute, Data, close, fold_problem, lambda_of, mirror_pair, random_case, trace, vertical_problem,
+    Brute, Data, close, fold_problem, lambda_ev, lambda_of, mirror_pair, random_case, trace,
+    vertical_problem,
 };
 use fricont::{Class, Event, Problem};
 
@@ -31,9 +32,9 @@ fn same_events(ctx: &str, a: &[Event], b: &[Event]) {
             (y.node, y.from, y.to, y.fold, y.bifurcation, y.transition),
             "{ctx}"
         );
-        let d = (lambda_of(&x.state) - lambda_of(&y.state)).amax();
+        let d = (lambda_ev(x) - lambda_ev(y)).amax();
         assert!(
-            d <= 1e-9 * 1f64.max(lambda_of(&x.state).amax()),
+            d <= 1e-9 * 1f64.max(lambda_ev(x).amax()),
             "{ctx}: λ differs by {d:e}"
         );
     }
@@ -48,8 +49,8 @@ fn check(ctx: &str, data: &Data, a0: f64, a1: f64, expected: Option<&Expected>) 
     for s in [1e-3, 1.0, 1e3] {
         let pr = base.with_r(s * r0).unwrap();
         assert_eq!(pr.r(), s * r0);
-        let path = trace(Arc::new(pr), data.affine_load(), a0, a1);
-        for e in path.events() {
+        let mut path = trace(Arc::new(pr), data.affine_load(), a0, a1);
+        for e in &common::events_with_state(&mut path) {
             assert!(
                 e.state.residual <= TOL,
                 "{ctx}, r = {s}·r0: residual {:e}",

@@ -18,7 +18,8 @@ use std::collections::BTreeSet;
 use std::sync::Arc;
 
 use common::{
-    Brute, Case, check_state, class_equations_hold, lambda_of, samples, symmetric_case, vclose,
+    Brute, Case, check_state, class_equations_hold, lambda_ev, lambda_of, samples, symmetric_case,
+    vclose,
 };
 use fricont::{Class, EndReason, Path, PathOptions, StepOutcome};
 
@@ -81,7 +82,8 @@ fn check_case(case: &Case, st: &mut Stats) {
             StepOutcome::End(_) => break,
         };
         st.transitions += 1;
-        let ev = &path.events()[range.clone()];
+        let all = common::events_with_state(&mut path);
+        let ev = &all[range.clone()];
         assert!(!ev.is_empty(), "{ctx}: a transition without events");
         let e0 = &ev[0];
         for e in ev {
@@ -125,7 +127,7 @@ fn check_case(case: &Case, st: &mut Stats) {
             }
         }
         // the continuations by enumeration
-        let lam = lambda_of(&e0.state);
+        let lam = lambda_ev(e0);
         let mut expected = br.incident(e0.alpha, &lam, 1e-9);
         expected.retain(|c| *c != prev);
         if bif {

@@ -823,10 +823,13 @@ pub unsafe extern "C" fn fricont_path_event_count(
     })
 }
 
-/// Copies event `k` (0-based, < the event count) into `*out` (not NULL).
+/// Copies event `k` (0-based, < the event count) into `*out` (not NULL). The event's
+/// `residual` is computed here: one back-solve with the factor of A (the tracer itself
+/// does no work proportional to n per event).
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (k out of range),
-/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK` (a general load callback
+/// failed when f(α) was evaluated), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
 ///
 /// # Safety
 /// `path` is NULL or a live handle; `out` is NULL or valid for one write.
@@ -839,12 +842,14 @@ pub unsafe extern "C" fn fricont_path_event(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let mut h = h.inner.borrow_mut();
         if out.is_null() {
             return Err(Failure::null("out"));
         }
-        let events = h.started()?.events();
-        let e = &events[index_in(k, events.len(), "event")?];
+        let path = h.started_mut()?;
+        let k = index_in(k, path.events().len(), "event")?;
+        let residual = path.event_state(k)?.residual;
+        let e = &path.events()[k];
         let v = fricont_event {
             index: e.index as i64,
             transition: e.transition as i64,
@@ -854,7 +859,7 @@ pub unsafe extern "C" fn fricont_path_event(
             to: class_code(e.to),
             fold: e.fold,
             bifurcation: e.bifurcation,
-            residual: e.state.residual,
+            residual,
         };
         // SAFETY: non-NULL and valid by contract.
         unsafe { out.write(v) };
@@ -864,11 +869,13 @@ pub unsafe extern "C" fn fricont_path_event(
 
 /// Copies the full state at event `k` (u, λν, λt, the classes of the piece after the
 /// event, residual) into the caller's buffers described by `*state` (see
-/// `fricont_state`). `state` may be NULL (nothing written).
+/// `fricont_state`). `state` may be NULL (nothing written). Costs one back-solve with the
+/// factor of A.
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
 /// `FRICONT_ERR_LENGTH` (a buffer too short), `FRICONT_ERR_ORDER` (not started),
-/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// `FRICONT_ERR_CALLBACK` (a general load callback failed), `FRICONT_ERR_POISONED`,
+/// `FRICONT_ERR_PANIC`.
 ///
 /// # Safety
 /// `path` is NULL or a live handle; `state` is NULL or an initialised struct whose
@@ -882,10 +889,11 @@ pub unsafe extern "C" fn fricont_path_event_state(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
-        let events = h.started()?.events();
-        let e = &events[index_in(k, events.len(), "event")?];
-        h.fill_state(&e.state, state)?;
+        let mut h = h.inner.borrow_mut();
+        let path = h.started_mut()?;
+        let k = index_in(k, path.events().len(), "event")?;
+        let st = path.event_state(k)?;
+        h.fill_state(&st, state)?;
         Ok(fricont_status::FRICONT_OK)
     })
 }

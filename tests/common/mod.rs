@@ -1152,3 +1152,36 @@ pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
     };
     Case { seed, data, a0, a1 }
 }
+
+/// An event with its full state (u by one back-solve, residual), as the tests read them;
+/// derefs to the event.
+#[derive(Debug)]
+pub struct EvState {
+    pub ev: fricont::Event,
+    pub state: State,
+}
+
+impl std::ops::Deref for EvState {
+    type Target = fricont::Event;
+    fn deref(&self) -> &fricont::Event {
+        &self.ev
+    }
+}
+
+/// Every event of the path with its state (`Path::event_state`).
+pub fn events_with_state(path: &mut Path) -> Vec<EvState> {
+    (0..path.events().len())
+        .map(|k| EvState {
+            ev: path.events()[k].clone(),
+            state: path.event_state(k).expect("event state"),
+        })
+        .collect()
+}
+
+/// `(λν, λt)` of an event as one vector.
+pub fn lambda_ev(e: &fricont::Event) -> DVector<f64> {
+    DVector::from_iterator(
+        e.lambda_n.len() * 2,
+        e.lambda_n.iter().chain(e.lambda_t.iter()).copied(),
+    )
+}
