@@ -440,7 +440,7 @@ typedef struct fricont_event {
      */
     bool bifurcation;
     /**
-     * ‖H‖∞ at the transition point divided by the data's scale (dimensionless).
+     * ‖H‖∞ at the transition point over max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞): a normwise backward error (dimensionless).
      */
     double residual;
 } fricont_event;
@@ -458,7 +458,7 @@ typedef struct fricont_state {
      */
     double alpha;
     /**
-     * Output: ‖H‖∞ / data scale at this point (dimensionless).
+     * Output: ‖H‖∞ over the scale of `fricont_event.residual` at this point (dimensionless).
      */
     double residual;
     /**

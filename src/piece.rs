@@ -432,39 +432,54 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// H1 = A u − f(α) − Nᵀ λν − Tᵀ λt
 /// H2 = λν − min(λν − r (N u − g), 0)
 /// H3 = λt − P_[−b, b](λt − r T u),   b = max(−F λν, 0)
-/// residual = ‖(H1, H2, H3)‖∞ / max(‖f‖∞, ‖A u‖∞, ‖Bᵀ λ‖∞, ‖λ‖∞, r ‖B u − (g, 0)‖∞, 1e-300)
+/// residual = ‖(H1, H2, H3)‖∞ / max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞)
 /// ```
 ///
-/// The scale is the largest force-like term of the equations, so the number is a relative
-/// backward error; it does not depend on the units chosen for `u` or `f`.
+/// The scale is the largest magnitude among the terms of the equations, taken entry by
+/// entry (`|A||u|` rather than `A u`), as in a normwise backward error: it is what
+/// rounding errors are proportional to, and it does not depend on the units of u or f.
 pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
     let (n, p, r) = (problem.n(), problem.p(), problem.r());
-    let mut au = vec![0.0; n];
-    problem.a().mul_vec(u, &mut au);
-    let mut btl = vec![0.0; n];
-    problem.b().mul_t_vec_add(lam, &mut btl);
     let mut h = 0.0f64;
     let mut scale = 1e-300f64;
+    let mut btl = vec![0.0; n];
+    let mut btl_abs = vec![0.0; n];
+    for (i, &l) in lam.iter().enumerate() {
+        for (j, v) in problem.b().row(i) {
+            btl[j] += v * l;
+            btl_abs[j] += (v * l).abs();
+        }
+    }
     for i in 0..n {
-        h = h.max((au[i] - f[i] - btl[i]).abs());
-        scale = scale.max(f[i].abs()).max(au[i].abs()).max(btl[i].abs());
+        let (mut au, mut au_abs) = (0.0, 0.0);
+        for (j, v) in problem.a().row(i) {
+            au += v * u[j];
+            au_abs += (v * u[j]).abs();
+        }
+        h = h.max((au - f[i] - btl[i]).abs());
+        scale = scale.max(au_abs).max(f[i].abs()).max(btl_abs[i]);
     }
     let mut bu = vec![0.0; 2 * p];
-    problem.b().mul_vec(u, &mut bu);
-    for i in 0..p {
-        bu[i] -= problem.gap()[i];
+    let mut bu_abs = vec![0.0; 2 * p];
+    for i in 0..2 * p {
+        for (j, v) in problem.b().row(i) {
+            bu[i] += v * u[j];
+            bu_abs[i] += (v * u[j]).abs();
+        }
     }
     for i in 0..p {
+        let g = problem.gap()[i];
         let (ln, lt) = (lam[i], lam[p + i]);
-        let h2 = ln - (ln - r * bu[i]).min(0.0);
+        let h2 = ln - (ln - r * (bu[i] - g)).min(0.0);
         let b = (-problem.friction()[i] * ln).max(0.0);
         let h3 = lt - (lt - r * bu[p + i]).clamp(-b, b);
         h = h.max(h2.abs()).max(h3.abs());
         scale = scale
             .max(ln.abs())
             .max(lt.abs())
-            .max(r * bu[i].abs())
-            .max(r * bu[p + i].abs());
+            .max(r * bu_abs[i])
+            .max(r * bu_abs[p + i])
+            .max(r * g.abs());
     }
     h / scale
 }

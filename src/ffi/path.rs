@@ -80,7 +80,7 @@ pub struct fricont_event {
     pub fold: bool,
     /// More than one neighbouring piece continues the path here.
     pub bifurcation: bool,
-    /// ‖H‖∞ at the transition point divided by the data's scale (dimensionless).
+    /// ‖H‖∞ at the transition point over max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞): a normwise backward error (dimensionless).
     pub residual: f64,
 }
 
@@ -95,7 +95,7 @@ pub struct fricont_event {
 pub struct fricont_state {
     /// Output: the load parameter α.
     pub alpha: f64,
-    /// Output: ‖H‖∞ / data scale at this point (dimensionless).
+    /// Output: ‖H‖∞ over the scale of `fricont_event.residual` at this point (dimensionless).
     pub residual: f64,
     /// Displacements u (n values, length units), or NULL.
     pub u: *mut f64,
