@@ -1010,8 +1010,8 @@ fricont_status fricont_path_event_count(const struct fricont_path *path,
  * does no work proportional to n per event).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (k out of range),
- * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK` (a general load callback
- * failed when f(α) was evaluated), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * No load callback is called: the load at the event was kept when it was found.
  *
  * # Safety
  * `path` is NULL or a live handle; `out` is NULL or valid for one write.
@@ -1028,8 +1028,7 @@ fricont_status fricont_path_event(const struct fricont_path *path,
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
  * `FRICONT_ERR_LENGTH` (a buffer too short), `FRICONT_ERR_ORDER` (not started),
- * `FRICONT_ERR_CALLBACK` (a general load callback failed), `FRICONT_ERR_POISONED`,
- * `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`. No load callback is called.
  *
  * # Safety
  * `path` is NULL or a live handle; `state` is NULL or an initialised struct whose

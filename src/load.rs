@@ -136,6 +136,19 @@ fn check_finite(name: &str, v: &[f64]) -> Result<()> {
     }
 }
 
+/// The load at one α, kept with an event so that its state can be computed later without
+/// calling the user's closures (a host such as MATLAB may only answer them during a
+/// step).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum LoadSnapshot {
+    /// Affine load: f(α) is known.
+    Affine,
+    /// Basis load: the weights φ_j(α).
+    Weights(Vec<f64>),
+    /// General load: f(α) itself (n values).
+    Force(Vec<f64>),
+}
+
 /// A load bound to a problem: the condensed vectors are precomputed where possible.
 pub(crate) struct BoundLoad {
     load: Load,
@@ -200,6 +213,41 @@ impl BoundLoad {
             });
         }
         Ok(())
+    }
+
+    /// What is needed to rebuild `f(α)` later without calling the user's closures:
+    /// nothing for an affine load, the weights for a basis load, `f(α)` itself otherwise.
+    pub(crate) fn snapshot(&mut self, alpha: f64) -> Result<LoadSnapshot> {
+        Ok(match &self.load {
+            Load::Affine { .. } => LoadSnapshot::Affine,
+            Load::Basis { .. } => {
+                self.eval_weights(alpha)?;
+                LoadSnapshot::Weights(self.weights.clone())
+            }
+            Load::General { .. } => LoadSnapshot::Force(self.force(alpha)?),
+        })
+    }
+
+    /// `f(α)` from a snapshot taken at the same α (no closure is called).
+    pub(crate) fn force_from(&self, alpha: f64, snap: &LoadSnapshot) -> Vec<f64> {
+        match (&self.load, snap) {
+            (Load::Affine { f0, f1 }, _) => f0
+                .iter()
+                .zip(f1.iter())
+                .map(|(a, b)| a + alpha * b)
+                .collect(),
+            (Load::Basis { vectors, .. }, LoadSnapshot::Weights(w)) => {
+                let mut f = vec![0.0; vectors[0].len()];
+                for (wj, v) in w.iter().zip(vectors) {
+                    for (fi, vi) in f.iter_mut().zip(v) {
+                        *fi += wj * vi;
+                    }
+                }
+                f
+            }
+            (_, LoadSnapshot::Force(f)) => f.clone(),
+            (_, _) => unreachable!("a snapshot always matches its load"),
+        }
     }
 
     /// The load vector `f(α)` (n entries).

@@ -12,7 +12,7 @@ use std::sync::Arc;
 
 use crate::class::Class;
 use crate::error::{Error, Result};
-use crate::load::{BoundLoad, Load};
+use crate::load::{BoundLoad, Load, LoadSnapshot};
 use crate::piece::{Consts, DenseLu, Guard, PieceLu, displacement_gaps, shift_gap};
 use crate::problem::Problem;
 use crate::solve::{solve_fixed_alpha, solve_with_frozen};
@@ -212,6 +212,8 @@ struct Trace {
     transitions: usize,
     /// Consecutive transitions at the same point (guards against cycling in place).
     zero_steps: usize,
+    /// The load at each event (index as `events`), for [`Path::event_state`].
+    event_loads: Vec<LoadSnapshot>,
     /// Entry points of the pieces: (classes, λ, α), for closed-loop detection.
     entries: Vec<(Vec<Class>, Vec<f64>, f64)>,
     /// The last transition, kept while a branch may still be chosen there.
@@ -353,17 +355,21 @@ impl Path {
         // (the free displacement under the load is often orders of magnitude larger than
         // u) and lose the residual's accuracy.
         let f = self.load.force(alpha)?;
+        Ok(self.state_with_force(lam, alpha, classes, f))
+    }
+
+    fn state_with_force(&self, lam: &[f64], alpha: f64, classes: &[Class], f: Vec<f64>) -> State {
         let u = self.problem.delassus().displacement(&f, lam);
         let residual = crate::piece::residual(&self.problem, &u, lam, &f);
         let p = self.problem.p();
-        Ok(State {
+        State {
             alpha,
             u,
             lambda_n: lam[..p].to_vec(),
             lambda_t: lam[p..].to_vec(),
             classes: classes.to_vec(),
             residual,
-        })
+        }
     }
 
     /// Tangent of piece `classes` at `pt` in raw coordinates, from the factorisation of
@@ -723,6 +729,7 @@ impl Path {
         self.trace = Some(Trace {
             start,
             events: Vec::new(),
+            event_loads: Vec::new(),
             pieces: vec![piece],
             entries: vec![(cand.classes.clone(), pt.lam.clone(), alpha)],
             cur: Cur {
@@ -1162,8 +1169,10 @@ impl Path {
         let scale = self.force_scale(&pt);
         let a_s = self.alpha_scale();
         let p = self.problem.p();
+        let snapshot = self.load.snapshot(pt.alpha)?;
         let tr = self.trace.as_mut().expect("started");
         tr.events.truncate(pend.events_start);
+        tr.event_loads.truncate(pend.events_start);
         tr.pieces.truncate(pend.pieces_len);
         let transition = tr.events.last().map(|e| e.transition + 1).unwrap_or(0);
         for i in 0..cand.classes.len() {
@@ -1182,6 +1191,7 @@ impl Path {
                     lambda_t: pt.lam[p..].to_vec(),
                     classes: cand.classes.clone(),
                 });
+                tr.event_loads.push(snapshot.clone());
             }
         }
         tr.pieces.push(PieceRecord {
@@ -1273,8 +1283,10 @@ impl Path {
     }
 
     /// The full state at event `k`: u by one back-solve of `f(α) + Bᵀλ`, and the residual.
-    /// Errors: not started, `k` out of range, load failure.
-    pub fn event_state(&mut self, k: usize) -> Result<State> {
+    /// Never calls the load's closures: the load at the event was kept when it was found
+    /// (nothing for an affine load, the weights for a basis load, f(α) for a general one).
+    /// Errors: not started, `k` out of range.
+    pub fn event_state(&self, k: usize) -> Result<State> {
         let tr = self.trace_ref()?;
         let e = tr.events.get(k).ok_or_else(|| {
             Error::Usage(format!(
@@ -1283,8 +1295,8 @@ impl Path {
             ))
         })?;
         let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
-        let (alpha, classes) = (e.alpha, e.classes.clone());
-        self.state(&lam, alpha, &classes)
+        let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
+        Ok(self.state_with_force(&lam, e.alpha, &e.classes, f))
     }
 
     /// The pieces so far (the last one is the current piece; empty before the start).

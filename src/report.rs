@@ -269,8 +269,6 @@ impl PathReport {
                 to: e.to.name(),
                 fold: e.fold,
                 bifurcation: e.bifurcation,
-                // the load was evaluated at this α while tracing; NaN (null in JSON) only
-                // if a general load callback now refuses it
                 residual: path.event_state(e.index).map_or(f64::NAN, |s| s.residual),
                 transition: e.transition + 1,
                 lambda_n: e.lambda_n.get(e.node).copied(),

@@ -183,7 +183,7 @@ fn printed_transitions_agree_with_tracing_the_files_read_back() {
     assert_eq!(written, report.table);
     let printed = parse_table(&report.table);
     assert_eq!(printed.len(), report.transitions.len());
-    let (case, mut path) = trace_dir(&out.join("problem"));
+    let (case, path) = trace_dir(&out.join("problem"));
     assert_same_events(&printed, &path, "case study");
     assert_eq!(case.n(), 1320);
     assert_eq!(case.p(), 30);
@@ -196,7 +196,7 @@ fn printed_transitions_agree_with_tracing_the_files_read_back() {
     let hf = out.join("high-friction");
     let written = std::fs::read_to_string(hf.join("transitions.txt")).unwrap();
     assert_eq!(written, fold.table);
-    let (case, mut path) = trace_dir(&hf.join("problem"));
+    let (case, path) = trace_dir(&hf.join("problem"));
     assert_same_events(&parse_table(&fold.table), &path, "high-friction variant");
     for k in 0..path.events().len() {
         let st = path.event_state(k).unwrap();

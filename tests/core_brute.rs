@@ -62,7 +62,7 @@ fn random_problems_against_enumeration() {
         );
 
         // Every event state solves the problem.
-        for e in &common::events_with_state(&mut path) {
+        for e in &common::events_with_state(&path) {
             assert!(
                 e.state.residual <= 1e-12,
                 "{ctx}: event {} residual {:e}",

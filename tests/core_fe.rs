@@ -40,7 +40,7 @@ fn fe_problems_against_enumeration() {
                 .any(|(c, l)| *c == start.classes && vclose(l, &sl, 1e-9)),
             "{ctx}: start"
         );
-        for e in &common::events_with_state(&mut path) {
+        for e in &common::events_with_state(&path) {
             assert!(
                 e.state.residual <= 1e-12,
                 "{ctx}: residual {:e}",

@@ -104,7 +104,7 @@ fn check_case(case: &Case, nsamples: usize) -> usize {
     }
     // Solves exactly at transition points reproduce the event state when the solution
     // there is unique (unique on both sides).
-    for e in &common::events_with_state(&mut path) {
+    for e in &common::events_with_state(&path) {
         if br.solutions_at(e.alpha - 1e-7).len() == 1 && br.solutions_at(e.alpha + 1e-7).len() == 1
         {
             let p = fresh(case, &problem, e.alpha, None);

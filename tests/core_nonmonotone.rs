@@ -129,7 +129,7 @@ fn sine_load(margin: f64) {
                     Path::new(problem.clone(), load, PathOptions::window(0.0, 2.0 * PI)).unwrap();
                 path.start(0.0, None).unwrap();
                 assert_eq!(path.run().unwrap(), EndReason::Window, "{ctx}");
-                let ev = common::events_with_state(&mut path);
+                let ev = common::events_with_state(&path);
                 let show = || {
                     format!(
                         "expected {:#?}\ngot {:#?}",

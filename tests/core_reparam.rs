@@ -111,9 +111,9 @@ fn check_reparam(
     }
     let (b0, b1) = (phi_inv(a0), phi_inv(a1));
     for (name, load) in loads(data) {
-        let mut path = trace(problem.clone(), load, b0, b1);
+        let path = trace(problem.clone(), load, b0, b1);
         assert_eq!(path.end_reason(), affine.end_reason(), "{ctx}, {name}");
-        let ev = common::events_with_state(&mut path);
+        let ev = common::events_with_state(&path);
         assert_eq!(ev.len(), expected.len(), "{ctx}, {name}: events {ev:#?}");
         for (k, (e, x)) in ev.iter().zip(expected).enumerate() {
             let want = phi_inv(x.0);

@@ -49,8 +49,8 @@ fn check(ctx: &str, data: &Data, a0: f64, a1: f64, expected: Option<&Expected>) 
     for s in [1e-3, 1.0, 1e3] {
         let pr = base.with_r(s * r0).unwrap();
         assert_eq!(pr.r(), s * r0);
-        let mut path = trace(Arc::new(pr), data.affine_load(), a0, a1);
-        for e in &common::events_with_state(&mut path) {
+        let path = trace(Arc::new(pr), data.affine_load(), a0, a1);
+        for e in &common::events_with_state(&path) {
             assert!(
                 e.state.residual <= TOL,
                 "{ctx}, r = {s}·r0: residual {:e}",

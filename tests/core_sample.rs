@@ -98,7 +98,7 @@ fn sample_rect30_events_confirmed() {
     let problem = Arc::new(s.builder.clone().build().unwrap());
     let mut path = trace(problem.clone(), data.affine_load(), s.a0, s.a1);
     assert_eq!(path.end_reason(), Some(&EndReason::Window));
-    let events = common::events_with_state(&mut path);
+    let events = common::events_with_state(&path);
     assert!(!events.is_empty());
     let pieces = path.pieces().to_vec();
     assert_eq!(
@@ -242,8 +242,8 @@ fn sample_rect30_transition_points_precise() {
     let mut runs = Vec::new();
     for f in [1e-3, 1.0, 1e3] {
         let pr = Arc::new(base.with_r(f * r0).unwrap());
-        let mut path = trace(pr, data.affine_load(), s.a0, s.a1);
-        let ev = common::events_with_state(&mut path);
+        let path = trace(pr, data.affine_load(), s.a0, s.a1);
+        let ev = common::events_with_state(&path);
         assert_eq!(ev.len(), want.len(), "r = {f}·r0");
         for (e, &(x, node, from, to)) in ev.iter().zip(&want) {
             assert_eq!((e.node, e.from, e.to), (node, from, to), "r = {f}·r0");

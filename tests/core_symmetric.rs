@@ -82,7 +82,7 @@ fn check_case(case: &Case, st: &mut Stats) {
             StepOutcome::End(_) => break,
         };
         st.transitions += 1;
-        let all = common::events_with_state(&mut path);
+        let all = common::events_with_state(&path);
         let ev = &all[range.clone()];
         assert!(!ev.is_empty(), "{ctx}: a transition without events");
         let e0 = &ev[0];

@@ -828,8 +828,8 @@ pub unsafe extern "C" fn fricont_path_event_count(
 /// does no work proportional to n per event).
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (k out of range),
-/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK` (a general load callback
-/// failed when f(α) was evaluated), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// No load callback is called: the load at the event was kept when it was found.
 ///
 /// # Safety
 /// `path` is NULL or a live handle; `out` is NULL or valid for one write.
@@ -842,11 +842,11 @@ pub unsafe extern "C" fn fricont_path_event(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let h = h.inner.borrow();
         if out.is_null() {
             return Err(Failure::null("out"));
         }
-        let path = h.started_mut()?;
+        let path = h.started()?;
         let k = index_in(k, path.events().len(), "event")?;
         let residual = path.event_state(k)?.residual;
         let e = &path.events()[k];
@@ -874,8 +874,7 @@ pub unsafe extern "C" fn fricont_path_event(
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
 /// `FRICONT_ERR_LENGTH` (a buffer too short), `FRICONT_ERR_ORDER` (not started),
-/// `FRICONT_ERR_CALLBACK` (a general load callback failed), `FRICONT_ERR_POISONED`,
-/// `FRICONT_ERR_PANIC`.
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`. No load callback is called.
 ///
 /// # Safety
 /// `path` is NULL or a live handle; `state` is NULL or an initialised struct whose
@@ -889,8 +888,8 @@ pub unsafe extern "C" fn fricont_path_event_state(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
-        let path = h.started_mut()?;
+        let h = h.inner.borrow();
+        let path = h.started()?;
         let k = index_in(k, path.events().len(), "event")?;
         let st = path.event_state(k)?;
         h.fill_state(&st, state)?;

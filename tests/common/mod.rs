@@ -1169,7 +1169,7 @@ impl std::ops::Deref for EvState {
 }
 
 /// Every event of the path with its state (`Path::event_state`).
-pub fn events_with_state(path: &mut Path) -> Vec<EvState> {
+pub fn events_with_state(path: &Path) -> Vec<EvState> {
     (0..path.events().len())
         .map(|k| EvState {
             ev: path.events()[k].clone(),
