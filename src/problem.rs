@@ -301,7 +301,8 @@ impl CsrMatrix {
 /// Which part of the symmetric matrix `A` the caller stores.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Storage {
-    /// Both triangles; symmetry is checked to a relative tolerance of 1e-10.
+    /// Both triangles; symmetry is checked to a relative tolerance of 1e-10, and the
+    /// matrix used is `(A + Aᵀ)/2`.
     Full,
     /// Only entries with `row ≥ col` (entries above the diagonal are an error).
     Lower,
@@ -535,7 +536,25 @@ fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatr
                     }
                 }
             }
-            Ok((keep(a, true), a.clone()))
+            // (A + Aᵀ)/2: uses both triangles the caller gave, and A and Aᵀ give
+            // bit-identical results (a row-major and a column-major caller agree).
+            let mut sym = a.clone();
+            for i in 0..n {
+                let (r0, r1) = (sym.row_ptr[i], sym.row_ptr[i + 1]);
+                let mut t = at.row(i).peekable();
+                for k in r0..r1 {
+                    let j = sym.col_idx[k];
+                    while t.peek().is_some_and(|&(c, _)| c < j) {
+                        t.next();
+                    }
+                    let w = match t.peek() {
+                        Some(&(c, w)) if c == j => w,
+                        _ => 0.0,
+                    };
+                    sym.values[k] = 0.5 * (sym.values[k] + w);
+                }
+            }
+            Ok((keep(&sym, true), sym))
         }
         Storage::Lower | Storage::Upper => {
             let lower = storage == Storage::Lower;
