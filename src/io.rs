@@ -209,10 +209,10 @@ impl CaseData {
                 self.f1.len()
             ));
         }
-        if let Some(g) = &self.gap {
-            if g.len() != p {
-                bad.push(format!("gap has {} entries, p = {p}", g.len()));
-            }
+        if let Some(g) = &self.gap
+            && g.len() != p
+        {
+            bad.push(format!("gap has {} entries, p = {p}", g.len()));
         }
         if self.friction.len() != 1 && self.friction.len() != p {
             bad.push(format!(
@@ -461,14 +461,14 @@ fn parse_mtx(
     let nrows = parse_count(path, size_ln, toks[0], "row count")?;
     let ncols = parse_count(path, size_ln, toks[1], "column count")?;
     let nnz = parse_count(path, size_ln, toks[2], "entry count")?;
-    if let Some((er, ec)) = expect {
-        if (er, ec) != (nrows, ncols) {
-            return Err(io_err(
-                path,
-                Some(size_ln),
-                format!("matrix is {nrows}x{ncols}, expected {er}x{ec} ({expect_what})"),
-            ));
-        }
+    if let Some((er, ec)) = expect
+        && (er, ec) != (nrows, ncols)
+    {
+        return Err(io_err(
+            path,
+            Some(size_ln),
+            format!("matrix is {nrows}x{ncols}, expected {er}x{ec} ({expect_what})"),
+        ));
     }
     if symmetric && nrows != ncols {
         return Err(io_err(

@@ -826,7 +826,7 @@ pub fn random_case(seed: u64) -> Case {
     let mut rng = Rng::new(seed);
     let p = 1 + (seed % 5) as usize;
     let n = 2 * p + rng.int(0, 3);
-    let (fmin, fmax) = if seed % 2 == 0 {
+    let (fmin, fmax) = if seed.is_multiple_of(2) {
         (0.05, 0.3)
     } else {
         (0.05, 3.0)
@@ -835,7 +835,7 @@ pub fn random_case(seed: u64) -> Case {
     // can make B nearly rank-deficient, and then transition points are only determined
     // to κ·ε by the data themselves, whatever the algorithm.
     let data = loop {
-        let d = Data::random(&mut rng, p, n, fmin, fmax, seed % 3 == 0);
+        let d = Data::random(&mut rng, p, n, fmin, fmax, seed.is_multiple_of(3));
         let br = Brute::condensed(&d);
         let ev = br.1.symmetric_eigenvalues();
         if ev.max() <= 1e3 * ev.min() {
@@ -973,7 +973,7 @@ pub fn symmetric_case(seed: u64, centre: bool) -> Case {
     let p = if centre { 3 } else { 2 };
     let fr = rng.range(0.1, 3.0);
     let fc = rng.range(0.1, 3.0);
-    let gap = if seed % 3 == 0 {
+    let gap = if seed.is_multiple_of(3) {
         rng.range(-0.1, 0.1)
     } else {
         0.0
@@ -1127,7 +1127,7 @@ pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
     }
     let gap = (0..p)
         .map(|_| {
-            if seed % 3 == 0 {
+            if seed.is_multiple_of(3) {
                 rng.range(0.0, 0.05)
             } else {
                 0.0
@@ -1145,7 +1145,7 @@ pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
         f0,
         f1,
     };
-    let (a0, a1) = if seed % 2 == 0 {
+    let (a0, a1) = if seed.is_multiple_of(2) {
         (-2.0, 4.0)
     } else {
         (4.0, -2.0)
