@@ -797,6 +797,27 @@ pub unsafe extern "C" fn fricont_path_callback_code(
     })
 }
 
+/// The body of the `*_count` queries: `*count = len(started path)`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `count` is NULL or valid for one write.
+unsafe fn write_count(
+    path: *const fricont_path,
+    count: *mut i64,
+    len: impl FnOnce(&Path) -> usize,
+) -> FfiResult<fricont_status> {
+    // SAFETY: NULL or a live handle, by contract.
+    let h = unsafe { handle_ref(path, "path") }?;
+    let h = h.inner.borrow();
+    if count.is_null() {
+        return Err(Failure::null("count"));
+    }
+    let c = len(h.started()?);
+    // SAFETY: non-NULL and valid by contract.
+    unsafe { count.write(c as i64) };
+    Ok(fricont_status::FRICONT_OK)
+}
+
 /// The number of events so far (`*count`, not NULL).
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
@@ -810,16 +831,8 @@ pub unsafe extern "C" fn fricont_path_event_count(
     count: *mut i64,
 ) -> fricont_status {
     ffi_boundary!(path => {
-        // SAFETY: NULL or a live handle, by contract.
-        let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
-        if count.is_null() {
-            return Err(Failure::null("count"));
-        }
-        let c = h.started()?.events().len();
-        // SAFETY: non-NULL and valid by contract.
-        unsafe { count.write(c as i64) };
-        Ok(fricont_status::FRICONT_OK)
+        // SAFETY: the caller's contract, passed on.
+        unsafe { write_count(path, count, |p| p.events().len()) }
     })
 }
 
@@ -960,16 +973,8 @@ pub unsafe extern "C" fn fricont_path_piece_count(
     count: *mut i64,
 ) -> fricont_status {
     ffi_boundary!(path => {
-        // SAFETY: NULL or a live handle, by contract.
-        let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
-        if count.is_null() {
-            return Err(Failure::null("count"));
-        }
-        let c = h.started()?.pieces().len();
-        // SAFETY: non-NULL and valid by contract.
-        unsafe { count.write(c as i64) };
-        Ok(fricont_status::FRICONT_OK)
+        // SAFETY: the caller's contract, passed on.
+        unsafe { write_count(path, count, |p| p.pieces().len()) }
     })
 }
 
@@ -1031,16 +1036,8 @@ pub unsafe extern "C" fn fricont_path_branch_count(
     count: *mut i64,
 ) -> fricont_status {
     ffi_boundary!(path => {
-        // SAFETY: NULL or a live handle, by contract.
-        let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
-        if count.is_null() {
-            return Err(Failure::null("count"));
-        }
-        let c = h.started()?.branches().len();
-        // SAFETY: non-NULL and valid by contract.
-        unsafe { count.write(c as i64) };
-        Ok(fricont_status::FRICONT_OK)
+        // SAFETY: the caller's contract, passed on.
+        unsafe { write_count(path, count, |p| p.branches().len()) }
     })
 }
 
