@@ -271,14 +271,19 @@ impl PathInner {
         if let Some(l) = lt {
             l.copy_from_slice(&st.lambda_t);
         }
-        if let Some(c) = cl {
-            for (c, k) in c.iter_mut().zip(&st.classes) {
-                *c = class_code(*k);
-            }
-        }
+        copy_classes(cl, &st.classes);
         out.alpha = st.alpha;
         out.residual = st.residual;
         Ok(())
+    }
+}
+
+/// Writes class codes into a caller buffer when one was given.
+fn copy_classes(dst: Option<&mut [i32]>, src: &[crate::Class]) {
+    if let Some(d) = dst {
+        for (c, k) in d.iter_mut().zip(src) {
+            *c = class_code(*k);
+        }
     }
 }
 
@@ -1004,11 +1009,7 @@ pub unsafe extern "C" fn fricont_path_piece(
         let pc = &pieces[index_in(k, pieces.len(), "piece")?];
         // SAFETY: NULL or valid for `classes_len` writes, by contract.
         let cl = unsafe { slice_out(classes, classes_len, h.p, "classes") }?;
-        if let Some(c) = cl {
-            for (c, k) in c.iter_mut().zip(&pc.classes) {
-                *c = class_code(*k);
-            }
-        }
+        copy_classes(cl, &pc.classes);
         let v = fricont_piece {
             alpha_from: pc.alpha_from,
             alpha_to: pc.alpha_to,
@@ -1066,11 +1067,7 @@ pub unsafe extern "C" fn fricont_path_branch(
         let b = &branches[index_in(k, branches.len(), "branch")?];
         // SAFETY: NULL or valid for `classes_len` writes, by contract.
         let cl = unsafe { slice_out(classes, classes_len, h.p, "classes") }?;
-        if let Some(c) = cl {
-            for (c, k) in c.iter_mut().zip(&b.classes) {
-                *c = class_code(*k);
-            }
-        }
+        copy_classes(cl, &b.classes);
         let v = fricont_branch {
             direction: b.direction as i32,
             orientation_preserving: b.orientation_preserving,
