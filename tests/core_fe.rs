@@ -53,46 +53,7 @@ fn fe_problems_against_enumeration() {
         if let Some(w) = &walk {
             walked += 1;
             let ev = path.events();
-            let exp: Vec<String> = w
-                .events
-                .iter()
-                .map(|e| {
-                    format!(
-                        "{:.15} node {} {} -> {} fold {}",
-                        e.phi, e.node, e.from, e.to, e.fold
-                    )
-                })
-                .collect();
-            let got: Vec<String> = ev
-                .iter()
-                .map(|e| {
-                    format!(
-                        "{:.15} node {} {} -> {} fold {}",
-                        e.alpha, e.node, e.from, e.to, e.fold
-                    )
-                })
-                .collect();
-            assert_eq!(
-                ev.len(),
-                w.events.len(),
-                "{ctx}: events\n expected {exp:#?}\n got {got:#?}"
-            );
-            for (e, x) in ev.iter().zip(&w.events) {
-                assert!(
-                    (e.alpha - x.phi).abs() <= 1e-12 * x.phi.abs().max(1.0),
-                    "{ctx}: event {} α = {:.17e}, brute force {:.17e}",
-                    e.index,
-                    e.alpha,
-                    x.phi
-                );
-                assert_eq!(
-                    (e.node, e.from, e.to, e.fold),
-                    (x.node, x.from, x.to, x.fold),
-                    "{ctx}: event {}\n expected {exp:#?}\n got {got:#?}",
-                    e.index
-                );
-                folds += e.fold as usize;
-            }
+            folds += common::assert_events_match_walk(&ctx, ev, w, 1e-12);
             events += ev.len();
             let want_end = if w.closed {
                 EndReason::ClosedLoop

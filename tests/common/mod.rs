@@ -1185,3 +1185,45 @@ pub fn lambda_ev(e: &fricont::Event) -> DVector<f64> {
         e.lambda_n.iter().chain(e.lambda_t.iter()).copied(),
     )
 }
+
+/// Asserts that traced events equal a brute-force walk's: same count, α to `tol` relative
+/// (to max(1, |α|)), same node, classes and fold flag, and no bifurcation. Returns the
+/// number of folds.
+pub fn assert_events_match_walk(ctx: &str, ev: &[fricont::Event], w: &Walk, tol: f64) -> usize {
+    let show = |a: f64, n: usize, f: Class, t: Class, fold: bool| {
+        format!("{a:.15} node {n} {f} -> {t} fold {fold}")
+    };
+    let exp: Vec<String> = w
+        .events
+        .iter()
+        .map(|e| show(e.phi, e.node, e.from, e.to, e.fold))
+        .collect();
+    let got: Vec<String> = ev
+        .iter()
+        .map(|e| show(e.alpha, e.node, e.from, e.to, e.fold))
+        .collect();
+    assert_eq!(
+        ev.len(),
+        w.events.len(),
+        "{ctx}: events\n expected {exp:#?}\n got {got:#?}"
+    );
+    let mut folds = 0;
+    for (e, x) in ev.iter().zip(&w.events) {
+        assert!(
+            (e.alpha - x.phi).abs() <= tol * 1f64.max(x.phi.abs()),
+            "{ctx}: event {} α = {:.17e}, brute force {:.17e} (diff {:e})",
+            e.index,
+            e.alpha,
+            x.phi,
+            e.alpha - x.phi
+        );
+        assert_eq!(
+            (e.node, e.from, e.to, e.fold, e.bifurcation),
+            (x.node, x.from, x.to, x.fold, false),
+            "{ctx}: event {}\n expected {exp:#?}\n got {got:#?}",
+            e.index
+        );
+        folds += e.fold as usize;
+    }
+    folds
+}
