@@ -140,7 +140,7 @@ static void compare(const char *what, const trace_result *a, const trace_result 
 }
 
 int main(int argc, char **argv) {
-    const char *dir = argc > 1 ? argv[1] : "../shared/cases/sample-rect30";
+    const char *dir = argc > 1 ? argv[1] : "tests/data/sample-rect30";
     case_data c;
     if (read_case(dir, &c)) {
         fprintf(stderr, "cannot read %s\n", dir);

@@ -6,12 +6,12 @@
 # last line is "N passed, M failed".
 #
 #   c-tests/run.sh            from the repository root or anywhere
-#   FRICONT_CASES=DIR         where the sample cases live (default ../shared/cases
-#                             relative to the repository root)
+#   FRICONT_CASES=DIR         where the sample cases live (default tests/data
+#                             in the repository)
 set -uo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
-CASES="${FRICONT_CASES:-$ROOT/../shared/cases}"
+CASES="${FRICONT_CASES:-$ROOT/tests/data}"
 OUT="$ROOT/target/c-tests"
 LIBDIR="$ROOT/target/release"
 mkdir -p "$OUT"

@@ -59,7 +59,4 @@ pub enum Error {
     /// A call made in the wrong order (e.g. stepping a path that was not started).
     #[error("usage: {0}")]
     Usage(String),
-    /// Reading or writing a file failed (CLI, exchange format).
-    #[error("{0}")]
-    Io(String),
 }

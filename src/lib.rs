@@ -45,18 +45,14 @@
 // Dense linear algebra on small index ranges reads best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-pub mod casestudy;
 pub mod class;
 pub mod condense;
 pub mod error;
 pub mod ffi;
-pub mod generator;
-pub mod io;
 pub mod load;
 pub mod path;
 pub mod piece;
 pub mod problem;
-pub mod report;
 pub mod solve;
 
 pub use class::Class;

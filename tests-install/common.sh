@@ -6,7 +6,7 @@
 # and defines need_cmd, ok, fail, run_check, build_reference, finish.
 set -u
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-CASE=${FRICONT_CASE:-$ROOT/../shared/cases/sample-rect30}
+CASE=${FRICONT_CASE:-$ROOT/tests/data/sample-rect30}
 LIBDIR=$ROOT/target/release
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/fricont-bind.XXXXXX")
 trap 'rm -rf "$WORK"' EXIT

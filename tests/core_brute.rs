@@ -1,4 +1,5 @@
-//! Brute force on random small problems (issue 2, "Tests", second item).
+//! Brute force on random small problems: the traced events equal those of an independent
+//! enumeration of every class vector.
 //!
 //! For random problems (p ≤ 5, n = 2p + 0..3, random SPD A, random dense full-rank N and
 //! T, friction up to 3, a random gap for some, a random affine load) the independent

@@ -1,4 +1,4 @@
-//! Data errors (issue 2, "What to build" 2 and 4): every `Error` variant reachable from bad
+//! Data errors: every `Error` variant reachable from bad
 //! data is provoked through `CsrMatrix::from_raw`, `ProblemBuilder`, `Load` and `Path`, and
 //! nothing panics (each call runs under `catch_unwind`, so a panic fails with a message
 //! naming the case instead of aborting the test).

@@ -1,4 +1,5 @@
-//! Fixed-α solves agree with the path (issue 2, "Tests", fifth item).
+//! Fixed-α solves agree with the path: the traced solution at α equals an independent
+//! fixed-α solve there.
 //!
 //! At sampled α a fresh path is started with the fixed-α solver: from no guess its
 //! solution must be one of the brute-force solutions (and the traced one when that is

@@ -1,4 +1,4 @@
-//! Hand-derived one- and two-node problems (issue 2, "Tests", first item).
+//! Hand-derived one- and two-node problems: events and states against closed forms.
 //!
 //! Every expected number below is derived by hand in the comments, in the condensed
 //! variables `d = q(α) + W λ − (g, 0)`, `W = B A⁻¹ Bᵀ`, `q = B A⁻¹ f(α)` (SPEC §2–3).

@@ -1,5 +1,5 @@
-//! A non-monotone load with a near-tangent double crossing (issue 2: "steps controlled by
-//! the guards' derivatives so that a double crossing inside one step is not skipped").
+//! A non-monotone load with a near-tangent double crossing (steps controlled by the
+//! guards' derivatives, so that a double crossing inside one step is not skipped).
 //!
 //! For random problems whose affine path is unique and fold-free on [−3, 3] (checked by
 //! the brute-force enumeration at many α), the load `f(β) = f0 + φ(β) f1` with

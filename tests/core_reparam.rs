@@ -1,4 +1,4 @@
-//! Reparametrisation (issue 2, "Tests", third item).
+//! Reparametrisation: tracing f(α) and f(φ(α)) gives the same transition points mapped by φ.
 //!
 //! With `f(β) = f0 + φ(β) f1`, `φ(β) = β³ + β` (strictly increasing), the solution set at
 //! β is the affine problem's solution set at α = φ(β). So the traced events must be at

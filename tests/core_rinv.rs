@@ -1,4 +1,4 @@
-//! r-invariance (issue 2, "Tests", fourth item): solutions and transition points do not
+//! r-invariance: solutions and transition points do not
 //! depend on the augmentation parameter r (SPEC §1). The same problems are traced with
 //! `Problem::with_r(s · default_r)` for s = 1e-3, 1, 1e3; the events must agree (α to
 //! 1e-12 relative, same nodes, classes and flags), and agree with the independent

@@ -19,14 +19,9 @@ use common::{Brute, Data, check_state, class_equations_hold, close, read_mtx, re
 use fricont::{CsrMatrix, EndReason, Path, PathOptions, ProblemBuilder, Storage};
 use nalgebra::{DMatrix, DVector};
 
-fn sample_dir() -> Option<PathBuf> {
-    let d = FsPath::new(env!("CARGO_MANIFEST_DIR")).join("../shared/cases/sample-rect30");
-    let d = if d.exists() {
-        d
-    } else {
-        PathBuf::from("/work/shared/cases/sample-rect30")
-    };
-    d.join("A.mtx").exists().then_some(d)
+/// The sample case shipped in the repository (a copy of the brief's `sample-rect30`).
+fn sample_dir() -> PathBuf {
+    FsPath::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sample-rect30")
 }
 
 struct Sample {
@@ -89,10 +84,7 @@ fn load_sample(dir: &FsPath) -> Sample {
 
 #[test]
 fn sample_rect30_events_confirmed() {
-    let Some(dir) = sample_dir() else {
-        eprintln!("sample-rect30 not found; skipped");
-        return;
-    };
+    let dir = sample_dir();
     let s = load_sample(&dir);
     let data = &s.data;
     let problem = Arc::new(s.builder.clone().build().unwrap());
@@ -199,14 +191,11 @@ fn sample_rect30_events_confirmed() {
 /// W, q, piece solves and guards with compensated dot products). For each event, the
 /// reference is where the traced piece before it ends, and (as a consistency check of
 /// the reference) where the piece after it begins. Checked for r = 1e-3, 1, 1e3 times
-/// the default, with relative tolerance 1e-12 (issue 2's acceptance); the events of the
+/// the default, with relative tolerance 1e-12; the events of the
 /// three runs must also agree with each other (r-invariance).
 #[test]
 fn sample_rect30_transition_points_precise() {
-    let Some(dir) = sample_dir() else {
-        eprintln!("sample-rect30 not found; skipped");
-        return;
-    };
+    let dir = sample_dir();
     let s = load_sample(&dir);
     let data = &s.data;
     let base = s.builder.clone().build().unwrap();

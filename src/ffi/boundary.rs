@@ -113,8 +113,6 @@ impl From<Error> for Failure {
             Error::SolveFailed { .. } => (FRICONT_ERR_SOLVE_FAILED, None),
             Error::Numerical(_) => (FRICONT_ERR_NUMERICAL, None),
             Error::Usage(_) => (FRICONT_ERR_ORDER, None),
-            // No C function reads or writes files; kept total for future variants.
-            Error::Io(_) => (FRICONT_ERR_NUMERICAL, None),
         };
         Self {
             status,

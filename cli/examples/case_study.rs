@@ -2,8 +2,8 @@
 //! (the CLI's `fricont case-study --out OUT` does the same).
 fn main() {
     let out = std::env::args().nth(1).unwrap_or_else(|| "out".into());
-    let opts = fricont::casestudy::CaseStudyOptions::new(out);
-    match fricont::casestudy::run(&opts) {
+    let opts = fricont_cli::casestudy::CaseStudyOptions::new(out);
+    match fricont_cli::casestudy::run(&opts) {
         Ok(r) => print!("{}", r.text()),
         Err(e) => {
             eprintln!("case study failed: {e}");

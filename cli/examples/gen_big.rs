@@ -5,13 +5,13 @@ fn main() {
         .skip(1)
         .map(|s| s.parse().unwrap())
         .collect();
-    let spec = fricont::generator::RectSpec {
+    let spec = fricont_exchange::generator::RectSpec {
         nx: a[0],
         ny: a[1],
         ..Default::default()
     };
     let t = std::time::Instant::now();
-    let c = fricont::generator::generate(&spec).unwrap();
+    let c = fricont_exchange::generator::generate(&spec).unwrap();
     println!(
         "n = {}, p = {}, nnz(A) = {}, generated in {:.2} s",
         c.n(),

@@ -5,9 +5,9 @@
 use std::sync::Arc;
 
 use fricont::Class;
-use fricont::generator::{RectSpec, Side, Traction, generate, load_vector};
 use fricont::load::Load;
 use fricont::path::{Path, PathOptions};
+use fricont_exchange::generator::{RectSpec, Side, Traction, generate, load_vector};
 
 fn main() {
     let base = RectSpec::default();

@@ -3,9 +3,9 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use fricont::casestudy::{seed_words, transition_rows};
-use fricont::generator::{RectSpec, generate};
 use fricont::path::{Path, PathOptions};
+use fricont_cli::casestudy::{seed_words, transition_rows};
+use fricont_exchange::generator::{RectSpec, generate};
 
 fn main() {
     let arg = std::env::args().nth(1).unwrap_or_else(|| "{}".into());

@@ -1,7 +1,7 @@
 //! Benchmark (not a test): set-up against trace time on a problem directory.
 //!
 //! ```text
-//! cargo bench --bench trace                 # ../shared/cases/sample-rect30
+//! cargo bench --bench trace                 # tests/data/sample-rect30
 //! cargo bench --bench trace -- DIR          # another problem directory
 //! FRICONT_BENCH_CASE=DIR FRICONT_BENCH_REPS=15 cargo bench --bench trace
 //! ```
@@ -17,8 +17,8 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
-use fricont::io::CaseData;
 use fricont::path::{Path, PathOptions};
+use fricont_exchange::io::CaseData;
 
 fn median_min(v: &mut [f64]) -> (f64, f64) {
     v.sort_by(f64::total_cmp);
@@ -38,7 +38,7 @@ fn main() {
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("FRICONT_BENCH_CASE").map(PathBuf::from))
         .unwrap_or_else(|| {
-            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/cases/sample-rect30")
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/data/sample-rect30")
         });
     let reps: usize = std::env::var("FRICONT_BENCH_REPS")
         .ok()

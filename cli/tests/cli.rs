@@ -1,5 +1,5 @@
 //! Integration tests of the `fricont` binary: the transition table and the JSON of SPEC §8
-//! on hand-derived problems and on `../shared/cases/sample-rect30`, exit status 2 with a
+//! on hand-derived problems and on the sample `tests/data/sample-rect30`, exit status 2 with a
 //! one-line message on broken input, and a confirmation of every event of the sample by
 //! independent fixed-α solves on both sides of it.
 
@@ -10,13 +10,13 @@ use std::sync::Arc;
 use serde_json::Value;
 
 use fricont::Class;
-use fricont::io::CaseData;
 use fricont::path::{Path, PathOptions};
+use fricont_exchange::io::CaseData;
 
 const BIN: &str = env!("CARGO_BIN_EXE_fricont");
 
 fn sample_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/cases/sample-rect30")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/data/sample-rect30")
 }
 
 /// A fresh empty directory under the system temp dir, removed on drop.

@@ -21,9 +21,9 @@ use std::time::Instant;
 
 use clap::{Parser, Subcommand};
 
-use fricont::io::CaseData;
 use fricont::path::{Path, PathOptions};
-use fricont::report::{self, Timing};
+use fricont_exchange::io::CaseData;
+use fricont_exchange::report::{self, Timing};
 
 /// Exact path-following of discrete 2D contact problems with Coulomb friction.
 #[derive(Parser, Debug)]
@@ -222,7 +222,7 @@ fn main() -> ExitCode {
 }
 
 fn gen_rect(a: &GenRectArgs) -> Result<(), Failure> {
-    use fricont::generator::{RectSpec, Traction};
+    use fricont_exchange::generator::{RectSpec, Traction};
     let mut spec = if a.press_shear {
         RectSpec::press_shear()
     } else {
@@ -245,7 +245,7 @@ fn gen_rect(a: &GenRectArgs) -> Result<(), Failure> {
         spec.load1 = parse(&a.load1)?;
         spec.load_name = "custom".into();
     }
-    let data = fricont::generator::generate(&spec).map_err(input)?;
+    let data = fricont_exchange::generator::generate(&spec).map_err(input)?;
     data.write_dir(&a.dir).map_err(input)?;
     println!(
         "wrote {} ({}: n = {}, p = {}, F = {})",
@@ -259,8 +259,8 @@ fn gen_rect(a: &GenRectArgs) -> Result<(), Failure> {
 }
 
 fn case_study(a: &CaseStudyArgs) -> Result<(), Failure> {
-    let opts = fricont::casestudy::CaseStudyOptions::new(a.out.clone());
-    let report = fricont::casestudy::run(&opts).map_err(runtime)?;
+    let opts = fricont_cli::casestudy::CaseStudyOptions::new(a.out.clone());
+    let report = fricont_cli::casestudy::run(&opts).map_err(runtime)?;
     print!("{}", report.text());
     Ok(())
 }

@@ -20,9 +20,9 @@
 use std::fmt::Write as _;
 use std::path::Path as FsPath;
 
-use crate::error::{Error, Result};
-use crate::load::Load;
-use crate::problem::{CsrMatrix, Problem, ProblemBuilder, Storage};
+use crate::{Error, Result};
+use fricont::load::Load;
+use fricont::problem::{CsrMatrix, Problem, ProblemBuilder, Storage};
 
 /// A problem in the exchange format, in memory.
 #[derive(Debug, Clone, PartialEq)]
@@ -176,13 +176,13 @@ impl CaseData {
         if let Some(r) = r {
             b = b.r(r);
         }
-        b.build()
+        Ok(b.build()?)
     }
 
     /// The affine load `f(α) = f0 + α f1` of the files. Errors: lengths differ, non-finite
     /// entries (see [`Load::affine`]).
     pub fn load(&self) -> Result<Load> {
-        Load::affine(self.f0.clone(), self.f1.clone())
+        Ok(Load::affine(self.f0.clone(), self.f1.clone())?)
     }
 
     fn check_dims(&self) -> Result<()> {
@@ -223,7 +223,7 @@ impl CaseData {
         if bad.is_empty() {
             Ok(())
         } else {
-            Err(Error::Dimension(bad.join("; ")))
+            Err(fricont::Error::Dimension(bad.join("; ")).into())
         }
     }
 }
@@ -802,7 +802,10 @@ mod tests {
         let mut c = CaseData::read_dir(&t.0).unwrap();
         c.f0.pop();
         let e = c.write_dir(&t.0.join("out")).unwrap_err();
-        assert!(matches!(e, Error::Dimension(_)), "{e}");
+        assert!(
+            matches!(e, Error::Core(fricont::Error::Dimension(_))),
+            "{e}"
+        );
     }
 
     /// Writes the hand case, replaces one file, reads, and returns the error message.

@@ -4,10 +4,10 @@
 use std::sync::Arc;
 
 use fricont::Storage;
-use fricont::generator::{RectSpec, Side, Traction, generate, load_vector};
 use fricont::load::Load;
 use fricont::path::{Path, PathOptions};
 use fricont::problem::ProblemBuilder;
+use fricont_exchange::generator::{RectSpec, Side, Traction, generate, load_vector};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();

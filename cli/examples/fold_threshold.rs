@@ -1,7 +1,7 @@
 //! For the case-study rectangle: the friction above which a single slipping contact node
 //! (all others open) has a singular piece, F_i = W_νν,ii / |W_νt,ii| (SPEC §4: the sign
 //! of det of the piece changes there). Exploration tool for docs/case-study.md.
-use fricont::generator::{RectSpec, generate};
+use fricont_exchange::generator::{RectSpec, generate};
 
 fn main() {
     let nu: f64 = std::env::args().nth(1).map_or(0.3, |s| s.parse().unwrap());

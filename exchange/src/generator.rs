@@ -51,9 +51,14 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{Error, Result};
 use crate::io::CaseData;
-use crate::problem::CsrMatrix;
+use crate::{Error, Result};
+
+/// An invalid generator parameter, as the core reports invalid parameters.
+fn invalid(m: String) -> Error {
+    fricont::Error::InvalidParameter(m).into()
+}
+use fricont::problem::CsrMatrix;
 
 /// A side of the rectangle.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -120,7 +125,7 @@ impl std::str::FromStr for Side {
             "right" => Ok(Side::Right),
             "top" => Ok(Side::Top),
             "left" => Ok(Side::Left),
-            _ => Err(Error::InvalidParameter(format!(
+            _ => Err(invalid(format!(
                 "side \"{s}\": expected bottom, right, top or left"
             ))),
         }
@@ -132,10 +137,10 @@ impl std::str::FromStr for Traction {
     /// Parses `SIDE:TX,TY` (uniform) or `SIDE:TX,TY:TX2,TY2` (linear from the first end
     /// of the side to the second), e.g. `top:0,-0.004:0,-0.024` or `right:0,0.01`
     /// (the command-line form of `fricont gen-rect`). Errors:
-    /// [`Error::InvalidParameter`] saying what is wrong.
+    /// [`fricont::Error::InvalidParameter`] saying what is wrong.
     fn from_str(s: &str) -> Result<Traction> {
         let bad = |m: &str| {
-            Error::InvalidParameter(format!(
+            invalid(format!(
                 "traction \"{s}\": {m} (expected SIDE:TX,TY or SIDE:TX,TY:TX2,TY2)"
             ))
         };
@@ -332,9 +337,9 @@ impl RectSpec {
         (i + 1) as f64 * self.h().0
     }
 
-    /// Checks the parameters. Errors: [`Error::InvalidParameter`] naming the field.
+    /// Checks the parameters. Errors: [`fricont::Error::InvalidParameter`] naming the field.
     pub fn validate(&self) -> Result<()> {
-        let bad = |m: String| Err(Error::InvalidParameter(m));
+        let bad = |m: String| Err(invalid(m));
         if self.nx < 2 || self.ny < 2 {
             return bad(format!(
                 "rectangle mesh needs nx ≥ 2 and ny ≥ 2 nodes (got {} × {})",
@@ -503,7 +508,9 @@ pub(crate) fn assemble_stiffness(
             }
         }
     }
-    CsrMatrix::from_raw("A", ndof, ndof, &row_ptr, &col_idx, &values, 0)
+    Ok(CsrMatrix::from_raw(
+        "A", ndof, ndof, &row_ptr, &col_idx, &values, 0,
+    )?)
 }
 
 /// Nodes of a side in increasing coordinate order, as `(i, j)`, and the edge length.
@@ -569,7 +576,7 @@ pub fn load_vector(spec: &RectSpec, tractions: &[Traction]) -> Vec<f64> {
 /// `N`, `T` (p × n, see the module doc for the signs), `f0`, `f1`, the gap (only when
 /// `spec.gap ≠ 0`), the friction and the α window, and a `meta.json` object with `n`,
 /// `p`, `F`, `alpha_start`, `alpha_end`, `E`, `nu`, `mesh`, `load` and the whole spec
-/// under `"spec"`. Errors: [`Error::InvalidParameter`] from [`RectSpec::validate`].
+/// under `"spec"`. Errors: [`fricont::Error::InvalidParameter`] from [`RectSpec::validate`].
 pub fn generate(spec: &RectSpec) -> Result<CaseData> {
     spec.validate()?;
     let (hx, hy) = spec.h();
@@ -931,7 +938,10 @@ mod tests {
         ];
         for s in cases {
             let e = generate(&s).unwrap_err();
-            assert!(matches!(e, Error::InvalidParameter(_)), "{e}");
+            assert!(
+                matches!(e, Error::Core(fricont::Error::InvalidParameter(_))),
+                "{e}"
+            );
         }
     }
 }

@@ -10,8 +10,8 @@ use std::fmt::Write as _;
 
 use serde_json::Value;
 
-use crate::class::Class;
-use crate::path::{EndReason, Event, Path};
+use fricont::class::Class;
+use fricont::path::{EndReason, Event, Path};
 
 /// Wall-clock times of a run, in seconds.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -1,4 +1,4 @@
-//! The case study end to end (issue 4):
+//! The case study end to end:
 //!
 //! * the printed transition list (the text the CLI prints, also in `transitions.txt`)
 //!   agrees with tracing the generated files read back through the exchange format:
@@ -13,11 +13,11 @@
 use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
 
-use fricont::casestudy::{CaseStudyOptions, CaseStudyReport, run};
-use fricont::generator::{RectSpec, generate};
-use fricont::io::CaseData;
 use fricont::path::{Path, PathOptions, State};
 use fricont::{Class, EndReason};
+use fricont_cli::casestudy::{CaseStudyOptions, CaseStudyReport, run};
+use fricont_exchange::generator::{RectSpec, generate};
+use fricont_exchange::io::CaseData;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("fricont-{name}-{}", std::process::id()));

@@ -1,5 +1,5 @@
 //! The founding paper's case study, end to end: generate the rectangle problem
-//! ([`crate::generator`]), write it in the exchange format, trace the path over the
+//! ([`fricont_exchange::generator`]), write it in the exchange format, trace the path over the
 //! paper's window, and write the transition table (in the paper's words), the figures
 //! (SVG) and the path (CSV, JSON). A high-friction variant of the same geometry is traced
 //! through its non-smooth folds, and every solution at one α inside a fold region is
@@ -26,12 +26,12 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use serde_json::{Value, json};
 
-use crate::class::Class;
-use crate::error::{Error, Result};
-use crate::generator::{RectSpec, Side, generate};
-use crate::io::CaseData;
-use crate::path::{EndReason, Path, PathOptions, State};
-use crate::problem::Problem;
+use fricont::class::Class;
+use fricont::path::{EndReason, Path, PathOptions, State};
+use fricont::problem::Problem;
+use fricont_exchange::generator::{RectSpec, Side, generate};
+use fricont_exchange::io::CaseData;
+use fricont_exchange::{Error, Result};
 
 /// What to run. `CaseStudyOptions::new(out)` gives the paper's case study.
 #[derive(Debug, Clone, PartialEq)]
@@ -1231,7 +1231,7 @@ fn path_json(path: &mut Path, case: &CaseData, setup_s: f64, trace_s: f64) -> Re
     let start = path
         .start_state()
         .cloned()
-        .ok_or_else(|| Error::Usage("path not started".into()))?;
+        .ok_or_else(|| Error::Core(fricont::Error::Usage("path not started".into())))?;
     let vertex = |s: &State| {
         let d = ContactData::from_state(s, case);
         json!({
