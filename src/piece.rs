@@ -20,44 +20,61 @@ use faer::{Mat, MatRef};
 use crate::class::Class;
 use crate::problem::Problem;
 
-/// A linear form `Σ a_j λ_j + Σ b_j d_j` with at most two λ terms and one d term.
+/// One term `coef · x[index]` of a linear form (a zero `coef` is an absent term).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Term {
+    pub index: usize,
+    pub coef: f64,
+}
+
+impl Term {
+    const NONE: Term = Term {
+        index: 0,
+        coef: 0.0,
+    };
+}
+
+/// A linear form `Σ a_j λ_j + b d_k` with at most two λ terms and one d term.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct LinForm {
-    pub a: [(usize, f64); 2],
-    pub b: (usize, f64),
+    /// The λ terms.
+    pub lam: [Term; 2],
+    /// The displacement-gap term (d = q + Wλ − (g, 0)).
+    pub disp: Term,
 }
 
 impl LinForm {
     fn lam(i: usize, c: f64) -> Self {
         Self {
-            a: [(i, c), (0, 0.0)],
-            b: (0, 0.0),
+            lam: [Term { index: i, coef: c }, Term::NONE],
+            disp: Term::NONE,
         }
     }
     fn lam2(i: usize, c: f64, j: usize, e: f64) -> Self {
         Self {
-            a: [(i, c), (j, e)],
-            b: (0, 0.0),
+            lam: [Term { index: i, coef: c }, Term { index: j, coef: e }],
+            disp: Term::NONE,
         }
     }
     fn disp(i: usize, c: f64) -> Self {
         Self {
-            a: [(0, 0.0), (0, 0.0)],
-            b: (i, c),
+            lam: [Term::NONE, Term::NONE],
+            disp: Term { index: i, coef: c },
         }
     }
     /// Value at `(λ, d)`; also the derivative along `(λ̇, ḋ)` (the forms are homogeneous).
     pub fn eval(&self, lam: &[f64], d: &[f64]) -> f64 {
-        self.a[0].1 * lam[self.a[0].0] + self.a[1].1 * lam[self.a[1].0] + self.b.1 * d[self.b.0]
+        let [a0, a1] = self.lam;
+        a0.coef * lam[a0.index] + a1.coef * lam[a1.index] + self.disp.coef * d[self.disp.index]
     }
     /// Row over `(λ, α)` (length m + 1) given W and `q'`.
     pub fn row(&self, w: MatRef<'_, f64>, dq: &[f64], out: &mut [f64]) {
         let m = w.nrows();
         out.iter_mut().for_each(|x| *x = 0.0);
-        for &(j, c) in &self.a {
-            out[j] += c;
+        for t in &self.lam {
+            out[t.index] += t.coef;
         }
-        let (j, c) = self.b;
+        let Term { index: j, coef: c } = self.disp;
         if c != 0.0 {
             for k in 0..m {
                 out[k] += c * w[(j, k)];
@@ -104,7 +121,7 @@ pub(crate) fn guard_kinds(c: Class) -> &'static [GuardKind] {
 
 /// Problem constants the forms need.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Consts<'a> {
+pub(crate) struct PieceConstants<'a> {
     pub p: usize,
     pub friction: &'a [f64],
     /// The user's r (equation rows).
@@ -113,7 +130,7 @@ pub(crate) struct Consts<'a> {
     pub r0: f64,
 }
 
-impl<'a> Consts<'a> {
+impl<'a> PieceConstants<'a> {
     pub fn of(problem: &'a Problem) -> Self {
         Self {
             p: problem.p(),
@@ -158,8 +175,8 @@ impl<'a> Consts<'a> {
         let mut rhs = vec![0.0; 2 * self.p];
         for (i, &c) in classes.iter().enumerate() {
             let [nu, t] = self.equations(i, c);
-            rhs[i] = -nu.b.1 * qg[nu.b.0];
-            rhs[self.p + i] = -t.b.1 * qg[t.b.0];
+            rhs[i] = -nu.disp.coef * qg[nu.disp.index];
+            rhs[self.p + i] = -t.disp.coef * qg[t.disp.index];
         }
         rhs
     }
@@ -204,7 +221,10 @@ impl<'a> Consts<'a> {
                     j[(r_idx, col)] = v;
                 }
                 // J (λ, α) + bᵀ(q − g) − row_α α = 0
-                let (bj, bc) = form.b;
+                let Term {
+                    index: bj,
+                    coef: bc,
+                } = form.disp;
                 rhs[r_idx] = -(bc * q_minus_g[bj]) + row[m] * alpha;
             }
         }

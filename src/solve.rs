@@ -15,7 +15,7 @@ use faer::MatRef;
 
 use crate::class::Class;
 use crate::error::{Error, Result};
-use crate::piece::{Consts, DenseLu, displacement_gaps};
+use crate::piece::{DenseLu, PieceConstants, displacement_gaps};
 
 /// Relative residual accepted as a solution.
 const TOL: f64 = 1e-12;
@@ -31,7 +31,7 @@ fn frozen_class(frozen: Frozen<'_>, i: usize) -> Option<Class> {
 /// `H2, H3` of the seed (2p values) at `λ`, and the force scale used to make it relative.
 /// Frozen nodes contribute the residuals of their class's equations instead.
 fn h_condensed(
-    c: &Consts,
+    c: &PieceConstants,
     w: MatRef<'_, f64>,
     qg: &[f64],
     lam: &[f64],
@@ -63,19 +63,25 @@ fn h_condensed(
     (h, scale)
 }
 
-fn rel_residual(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Frozen<'_>) -> f64 {
+fn rel_residual(
+    c: &PieceConstants,
+    w: MatRef<'_, f64>,
+    qg: &[f64],
+    lam: &[f64],
+    fr: Frozen<'_>,
+) -> f64 {
     let (h, s) = h_condensed(c, w, qg, lam, fr);
     h.iter().fold(0.0f64, |m, v| m.max(v.abs())) / s
 }
 
-fn merit(c: &Consts, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Frozen<'_>) -> f64 {
+fn merit(c: &PieceConstants, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Frozen<'_>) -> f64 {
     let (h, _) = h_condensed(c, w, qg, lam, fr);
     0.5 * h.iter().map(|v| v * v).sum::<f64>()
 }
 
 /// The classes of the generalized Jacobian at `λ` (projection arguments).
 fn active_classes(
-    c: &Consts,
+    c: &PieceConstants,
     w: MatRef<'_, f64>,
     qg: &[f64],
     lam: &[f64],
@@ -107,7 +113,7 @@ fn active_classes(
 
 /// Solves the piece equations of `classes` at fixed α (None if the piece is singular).
 pub(crate) fn solve_piece(
-    c: &Consts,
+    c: &PieceConstants,
     w: MatRef<'_, f64>,
     classes: &[Class],
     qg: &[f64],
@@ -127,7 +133,7 @@ pub(crate) fn solve_piece(
 /// Semi-smooth Newton with Armijo backtracking. Returns the last iterate and whether it
 /// converged, plus a short description.
 fn newton(
-    c: &Consts,
+    c: &PieceConstants,
     w: MatRef<'_, f64>,
     qg: &[f64],
     lam0: Vec<f64>,
@@ -257,7 +263,7 @@ fn local_class(wl: [[f64; 2]; 2], d0: [f64; 2], f: f64, cl: Class) -> Option<[f6
 }
 
 fn block_gauss_seidel(
-    c: &Consts,
+    c: &PieceConstants,
     w: MatRef<'_, f64>,
     qg: &[f64],
     lam0: Vec<f64>,
@@ -316,7 +322,7 @@ pub(crate) fn solve_with_frozen(
     alpha: f64,
     fr: Frozen<'_>,
 ) -> Result<Vec<f64>> {
-    let c = Consts::of(problem);
+    let c = PieceConstants::of(problem);
     let w = problem.delassus().w();
     let m = 2 * c.p;
     let lam0 = guess.map(|g| g.to_vec()).unwrap_or_else(|| vec![0.0; m]);
@@ -346,7 +352,7 @@ pub(crate) fn solve_with_frozen(
     })
 }
 
-fn stick_start(c: &Consts, w: MatRef<'_, f64>, qg: &[f64]) -> Vec<f64> {
+fn stick_start(c: &PieceConstants, w: MatRef<'_, f64>, qg: &[f64]) -> Vec<f64> {
     let classes = vec![Class::Stick; c.p];
     solve_piece(c, w, &classes, qg).unwrap_or_else(|| vec![0.0; 2 * c.p])
 }

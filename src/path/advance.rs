@@ -1,0 +1,291 @@
+//! Advancing inside a piece: the exact ratio test of an affine load
+//! ([`Path::exit_linear`]) and the certified steps of a nonlinear load
+//! ([`Path::exit_graph`]), both on the table of guard values and derivatives.
+
+use super::roots::{brent, hermite_min};
+use super::*;
+
+/// A guard with its value and its derivative along the tangent.
+pub(super) struct GuardRow {
+    pub(super) guard: Guard,
+    /// The guard's value at the point (force units; ≥ 0 inside the piece).
+    pub(super) value: f64,
+    /// Its derivative along the tangent (0 when no tangent is given).
+    pub(super) slope: f64,
+}
+
+/// Where advancing on the current piece stops: the window's end, or a point where guards
+/// reach zero (a transition point, with the guards that cross there).
+pub(super) enum Exit {
+    Window(Point),
+    Guards(Point, Vec<Guard>),
+}
+
+impl Path {
+    /// Values and derivatives along `t` of all guards of `classes` at `pt`.
+    pub(super) fn guard_table(
+        &self,
+        classes: &[Class],
+        pt: &Point,
+        t: Option<&[f64]>,
+    ) -> Vec<GuardRow> {
+        let c = self.consts();
+        let m = 2 * c.p;
+        let w = self.problem.delassus().w();
+        let qg = shift_gap(&pt.q, self.problem.gap());
+        let d = displacement_gaps(w, &qg, &pt.lam);
+        let (lt, dt) = match t {
+            Some(t) => {
+                let mut dd = displacement_gaps(w, &vec![0.0; m], &t[..m]);
+                for (k, v) in dd.iter_mut().enumerate() {
+                    *v += pt.dq[k] * t[m];
+                }
+                (t[..m].to_vec(), dd)
+            }
+            None => (vec![0.0; m], vec![0.0; m]),
+        };
+        c.guards(classes)
+            .into_iter()
+            .map(|g| {
+                let f = c.guard_form(g);
+                GuardRow {
+                    guard: g,
+                    value: f.eval(&pt.lam, &d),
+                    slope: f.eval(&lt, &dt),
+                }
+            })
+            .collect()
+    }
+
+    /// Exit of a straight piece (affine load, or a vertical piece): ratio test on the
+    /// guards and the window, then the exact point by one bordered solve.
+    pub(super) fn exit_linear(&mut self, cur: &CurrentPiece) -> Result<Exit> {
+        let m = 2 * self.problem.p();
+        let pt = self.point_at(cur.lam.clone(), cur.alpha)?;
+        let scale = self.force_scale(&pt);
+        let tol = self.opts.zero_tol * scale;
+        let table = self.guard_table(&cur.classes, &pt, Some(&cur.t));
+        let mut best: Option<(f64, Guard)> = None;
+        for &GuardRow {
+            guard: g,
+            value: v,
+            slope: vd,
+        } in &table
+        {
+            if vd < -tol {
+                let s = (v / -vd).max(0.0);
+                if best.is_none_or(|b| s < b.0) {
+                    best = Some((s, g));
+                }
+            }
+        }
+        let (lo, hi) = self.window();
+        let ta = cur.t[m];
+        let s_win = if ta > 0.0 {
+            Some((hi - cur.alpha) / ta)
+        } else if ta < 0.0 {
+            Some((lo - cur.alpha) / ta)
+        } else {
+            None
+        };
+        let problem = self.problem.clone();
+        let c = PieceConstants::of(&problem);
+        let w = problem.delassus().w();
+        match (best, s_win) {
+            (None, None) => Err(Error::Numerical(format!(
+                "vertical piece at alpha = {:e} with no exit: the continuum is unbounded",
+                cur.alpha
+            ))),
+            (b, Some(sw)) if b.is_none_or(|b| sw <= b.0) => {
+                let alpha = if ta > 0.0 { hi } else { lo };
+                let pt = self.point_at(vec![0.0; m], alpha)?;
+                let qg = shift_gap(&pt.q, self.problem.gap());
+                let mlu = DenseLu::new(c.piece_matrix(w, &cur.classes).as_ref());
+                let lam = mlu.solve(&c.piece_rhs(&cur.classes, &qg));
+                Ok(Exit::Window(Point { lam, ..pt }))
+            }
+            (Some((s, g)), _) => {
+                let (lam, alpha) = if self.load.is_affine() {
+                    // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
+                    // piece's factorisation) and τ from the guard's equation; no drift
+                    // from earlier points enters.
+                    let qg = shift_gap(&pt.q, self.problem.gap());
+                    let (_, rhs) = c.jacobian(w, &cur.classes, &qg, &pt.dq, pt.alpha);
+                    let form = c.guard_form(g);
+                    let mut row = vec![0.0; m + 1];
+                    form.row(w, &pt.dq, &mut row);
+                    let v0 = table
+                        .iter()
+                        .find(|e| e.guard == g)
+                        .map(|e| e.value)
+                        .unwrap_or(0.0);
+                    let c0 = v0
+                        - row[..m]
+                            .iter()
+                            .zip(&cur.lam)
+                            .map(|(a, b)| a * b)
+                            .sum::<f64>()
+                        - row[m] * cur.alpha;
+                    let (sc, a_s) = (cur.scales.force, cur.scales.alpha);
+                    let mut xp = cur.lu.particular(&rhs);
+                    for v in xp.iter_mut().take(m) {
+                        *v *= sc;
+                    }
+                    xp[m] *= a_s;
+                    let dot = |x: &[f64]| row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
+                    let tau = (-c0 - dot(&xp)) / dot(&cur.t);
+                    let x: Vec<f64> = xp.iter().zip(&cur.t).map(|(a, b)| a + tau * b).collect();
+                    if x.iter().all(|v| v.is_finite()) {
+                        (x[..m].to_vec(), x[m])
+                    } else {
+                        let lam = cur.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
+                        (lam, cur.alpha + s * cur.t[m])
+                    }
+                } else {
+                    let lam = cur.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
+                    (lam, cur.alpha)
+                };
+                let pt = self.point_at(lam, alpha)?;
+                Ok(Exit::Guards(pt, vec![g]))
+            }
+            (None, Some(_)) => unreachable!("handled by the window arm"),
+        }
+    }
+
+    /// Exit of a graph piece under a nonlinear load: march in α with steps that the
+    /// guards' Hermite interpolants certify free of double crossings, then Brent.
+    pub(super) fn exit_graph(&mut self, cur: &CurrentPiece) -> Result<Exit> {
+        let m = 2 * self.problem.p();
+        let dir = if cur.t[m] > 0.0 { 1.0 } else { -1.0 };
+        let (lo, hi) = self.window();
+        let bound = if dir > 0.0 { hi } else { lo };
+        let span = self.alpha_scale();
+        let mlu = {
+            let c = self.consts();
+            DenseLu::new(
+                c.piece_matrix(self.problem.delassus().w(), &cur.classes)
+                    .as_ref(),
+            )
+        };
+        let classes = cur.classes.clone();
+        let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<GuardRow>)> {
+            let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
+            let c = this.consts();
+            let qg = shift_gap(&q, this.problem.gap());
+            let lam = mlu.solve(&c.piece_rhs(&classes, &qg));
+            let dl = mlu.solve(&c.piece_rhs(&classes, &dq));
+            let mut t = dl;
+            t.push(1.0);
+            let pt = Point { lam, alpha, q, dq };
+            let table = this.guard_table(&classes, &pt, Some(&t));
+            Ok((pt, table))
+        };
+        let (mut pa, mut ga) = eval(self, cur.alpha)?;
+        let mut h = (span / 32.0).min((bound - cur.alpha).abs());
+        let hmin = span * 1e-12;
+        loop {
+            let scale = self.force_scale(&pa);
+            let tol = self.opts.zero_tol * scale;
+            let at_bound = (bound - pa.alpha).abs() <= h;
+            let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
+            let (mut pb, mut gb) = eval(self, b_alpha)?;
+            // A guard the piece just entered (zero at a, increasing) that is negative at b:
+            // the step overshoots the piece's first stretch; shorten it.
+            let premature = (0..gb.len())
+                .any(|k| ga[k].value <= tol && dir * ga[k].slope > 0.0 && gb[k].value < -tol);
+            if premature && h > hmin {
+                h *= 0.5;
+                continue;
+            }
+            // A guard positive at both ends with a minimum inside (its derivative changes
+            // sign) may dip below zero and come back: locate the minimum (Brent on the
+            // derivative) and look at the guard there. A double crossing inside one step
+            // is never skipped, however close to tangent.
+            let mut cut: Option<f64> = None;
+            for k in 0..gb.len() {
+                if ga[k].value > -tol
+                    && gb[k].value >= -tol
+                    && dir * ga[k].slope < 0.0
+                    && dir * gb[k].slope > 0.0
+                {
+                    let mut err = None;
+                    let smin = brent(
+                        pa.alpha,
+                        pb.alpha,
+                        dir * ga[k].slope,
+                        dir * gb[k].slope,
+                        |x| match eval(self, x) {
+                            Ok((_, tab)) => dir * tab[k].slope,
+                            Err(e) => {
+                                err = Some(e);
+                                f64::NAN
+                            }
+                        },
+                    );
+                    if let Some(e) = err {
+                        return Err(e);
+                    }
+                    let (_, tab) = eval(self, smin)?;
+                    if tab[k].value < -tol && cut.is_none_or(|c| dir * (smin - c) < 0.0) {
+                        cut = Some(smin);
+                    }
+                }
+            }
+            if let Some(smin) = cut {
+                (pb, gb) = eval(self, smin)?;
+            }
+            let at_bound = at_bound && cut.is_none();
+            let delta = pb.alpha - pa.alpha;
+            let crossing: Vec<usize> = (0..gb.len()).filter(|&k| gb[k].value < -tol).collect();
+            if crossing.is_empty() {
+                // Hermite check for a dip below zero inside the step
+                let dip = (0..gb.len()).any(|k| {
+                    let (v0, v1) = (ga[k].value, gb[k].value);
+                    let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
+                    hermite_min(v0, v1, m0, m1) < -tol
+                });
+                if dip && h > hmin {
+                    h *= 0.5;
+                    continue;
+                }
+                if at_bound {
+                    return Ok(Exit::Window(pb));
+                }
+                pa = pb;
+                ga = gb;
+                h = (2.0 * h).min(span / 8.0);
+                continue;
+            }
+            // Brent on each crossing guard; the earliest root wins.
+            let mut first: Option<(f64, Guard)> = None;
+            for &k in &crossing {
+                let g = gb[k].guard;
+                let (a0, b0) = (pa.alpha, pb.alpha);
+                let fa = ga[k].value;
+                let fb = gb[k].value;
+                let root = if fa <= 0.0 {
+                    a0
+                } else {
+                    let mut err = None;
+                    let r = brent(a0, b0, fa, fb, |x| match eval(self, x) {
+                        Ok((_, tab)) => tab[k].value,
+                        Err(e) => {
+                            err = Some(e);
+                            f64::NAN
+                        }
+                    });
+                    if let Some(e) = err {
+                        return Err(e);
+                    }
+                    r
+                };
+                if first.is_none_or(|f| dir * (root - f.0) < 0.0) {
+                    first = Some((root, g));
+                }
+            }
+            let (root, g) = first.expect("at least one crossing");
+            let (pt, _) = eval(self, root)?;
+            return Ok(Exit::Guards(pt, vec![g]));
+        }
+    }
+}

@@ -1,0 +1,481 @@
+//! Joining at a transition point: the classes that fit a point, the neighbouring pieces
+//! that contain it and enter their own region, the directional problem at a zero-force
+//! vertex, folds, bifurcations and the choice of a branch.
+
+use super::advance::GuardRow;
+use super::*;
+
+impl Path {
+    /// Classes of node `i` whose equations and guards hold at the point (to `tol`, in
+    /// force units).
+    pub(super) fn compatible(&self, i: usize, pt: &Point, tol: f64) -> Vec<Class> {
+        let w = self.problem.delassus().w();
+        let qg = shift_gap(&pt.q, self.problem.gap());
+        let d = displacement_gaps(w, &qg, &pt.lam);
+        self.compatible_at(i, &pt.lam, &d, tol)
+    }
+
+    /// Classes of node `i` compatible with `(λ, d)` (to `tol`, in force units).
+    pub(super) fn compatible_at(&self, i: usize, lam: &[f64], d: &[f64], tol: f64) -> Vec<Class> {
+        let c = self.consts();
+        let r0 = c.r0;
+        Class::ALL
+            .into_iter()
+            .filter(|&cl| {
+                let eq_ok = c.equations(i, cl).iter().all(|e| {
+                    // equations in force units: displacement rows scaled by r0 instead of r
+                    let [a0, a1] = e.lam;
+                    let v = a0.coef * lam[a0.index]
+                        + a1.coef * lam[a1.index]
+                        + if e.disp.coef != 0.0 {
+                            e.disp.coef.signum() * r0 * d[e.disp.index]
+                        } else {
+                            0.0
+                        };
+                    v.abs() <= tol
+                });
+                eq_ok
+                    && crate::piece::guard_kinds(cl)
+                        .iter()
+                        .all(|&kind| c.guard_form(Guard { node: i, kind }).eval(lam, d) >= -tol)
+            })
+            .collect()
+    }
+
+    /// Adds the directions of piece `classes` through `pt` that enter its region.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn push_candidates(
+        &self,
+        classes: &[Class],
+        pt: &Point,
+        scale: f64,
+        tol: f64,
+        back: Option<(&[Class], &[f64])>,
+        relaxed: bool,
+        out: &mut Vec<Candidate>,
+    ) {
+        // The piece the path came from cannot continue it: its crossing guard decreases
+        // forward, and backward is where the path came from.
+        if back.is_some_and(|(bc, _)| bc == classes) {
+            return;
+        }
+        let Some((t, lu, scales)) = self.tangent(classes, pt, scale) else {
+            return;
+        };
+        let lu = Arc::new(lu);
+        for s in [1.0, -1.0] {
+            let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
+            if out.iter().any(|c| {
+                c.classes == classes && c.t.iter().zip(&ts).map(|(a, b)| a * b).sum::<f64>() > 0.0
+            }) {
+                continue;
+            }
+            let enters = self.guard_table(classes, pt, Some(&ts)).iter().all(|row| {
+                let (v, vd) = (row.value, row.slope);
+                if v > tol {
+                    true
+                } else if v < -tol {
+                    false
+                } else if relaxed {
+                    vd >= -tol
+                } else {
+                    vd > tol
+                }
+            });
+            if enters {
+                let orientation = if s > 0.0 {
+                    lu.orientation
+                } else {
+                    -lu.orientation
+                };
+                let m = ts.len() - 1;
+                let det_sign = if ts[m].abs() <= 1e-14 {
+                    0
+                } else {
+                    orientation * sign(ts[m])
+                };
+                out.push(Candidate {
+                    orientation,
+                    classes: classes.to_vec(),
+                    t: ts,
+                    det_sign,
+                    lu: lu.clone(),
+                    scales,
+                });
+            }
+        }
+    }
+
+    /// Every neighbouring piece that contains `pt` and whose direction enters its region.
+    /// `fixed` gives the class of every node not in `nodes`; the nodes in `nodes` take all
+    /// their compatible classes. `back` = (classes, tangent) of the way the path came.
+    ///
+    /// Nodes at the *vertex* (`λ_i = 0`, `d_i = 0`: every class fits) are not enumerated
+    /// when there are more than two of them: the continuation from such a point is
+    /// positively homogeneous, so their classes are read off the solution of the
+    /// directional contact problem `ḋ = W λ̇ ± q'` (the other nodes keep their class).
+    pub(super) fn continuations(
+        &self,
+        pt: &Point,
+        fixed: &[Class],
+        nodes: &[usize],
+        back: Option<(&[Class], &[f64])>,
+        relaxed: bool,
+    ) -> Result<Vec<Candidate>> {
+        let scale = self.force_scale(pt);
+        let tol = self.opts.zero_tol * scale;
+        let options: Vec<Vec<Class>> = nodes.iter().map(|&i| self.compatible(i, pt, tol)).collect();
+        if let Some(k) = options.iter().position(|o| o.is_empty()) {
+            return Err(Error::Numerical(format!(
+                "node {} fits no class at alpha = {:e} (the point is not a solution)",
+                nodes[k] + 1,
+                pt.alpha
+            )));
+        }
+        let is_vertex: Vec<bool> = options.iter().map(|o| o.len() == 4).collect();
+        let n_vertex = is_vertex.iter().filter(|&&v| v).count();
+        let use_directional = n_vertex > 2;
+        let enumerated: Vec<usize> = (0..nodes.len())
+            .filter(|&k| !(use_directional && is_vertex[k]))
+            .collect();
+        let combos = enumerated
+            .iter()
+            .fold(1usize, |acc, &k| acc.saturating_mul(options[k].len()));
+        if combos > MAX_CANDIDATE_PIECES {
+            return Err(Error::Numerical(format!(
+                "{} nodes are at a class boundary at once at alpha = {:e}: {combos} neighbouring pieces exceed the limit of {MAX_CANDIDATE_PIECES}",
+                enumerated.len(),
+                pt.alpha
+            )));
+        }
+        let mut out = Vec::new();
+        let mut idx = vec![0usize; enumerated.len()];
+        loop {
+            let mut classes = fixed.to_vec();
+            for (k, &e) in enumerated.iter().enumerate() {
+                classes[nodes[e]] = options[e][idx[k]];
+            }
+            if use_directional {
+                let frozen: Vec<Option<Class>> = (0..classes.len())
+                    .map(|i| {
+                        let v = nodes
+                            .iter()
+                            .position(|&n| n == i)
+                            .is_some_and(|k| is_vertex[k]);
+                        (!v).then_some(classes[i])
+                    })
+                    .collect();
+                for s in [1.0, -1.0] {
+                    if let Some(cl) = self.directional_classes(pt, &frozen, s) {
+                        self.push_candidates(&cl, pt, scale, tol, back, relaxed, &mut out);
+                    }
+                }
+            } else {
+                self.push_candidates(&classes, pt, scale, tol, back, relaxed, &mut out);
+            }
+            // next combination
+            let mut k = 0;
+            loop {
+                if k == enumerated.len() {
+                    return Ok(out);
+                }
+                idx[k] += 1;
+                if idx[k] < options[enumerated[k]].len() {
+                    break;
+                }
+                idx[k] = 0;
+                k += 1;
+            }
+        }
+    }
+
+    /// Classes of the free (vertex) nodes on the continuation with `α̇ = s`: the solution of
+    /// the contact problem for the derivatives, `ḋ = W λ̇ + s q'`, with the frozen nodes'
+    /// equations. None when that problem has no solution or a free node stays degenerate.
+    pub(super) fn directional_classes(
+        &self,
+        pt: &Point,
+        frozen: &[Option<Class>],
+        s: f64,
+    ) -> Option<Vec<Class>> {
+        let qdir: Vec<f64> = pt.dq.iter().map(|v| s * v).collect();
+        let lam = solve_with_frozen(&self.problem, &qdir, None, pt.alpha, Some(frozen)).ok()?;
+        let w = self.problem.delassus().w();
+        let d = displacement_gaps(w, &qdir, &lam);
+        let r0 = self.problem.default_r();
+        let sc = inf_norm(&lam).max(r0 * inf_norm(&qdir)).max(1e-300);
+        let tol = self.opts.zero_tol * sc;
+        let mut classes = Vec::with_capacity(frozen.len());
+        for (i, f) in frozen.iter().enumerate() {
+            match f {
+                Some(c) => classes.push(*c),
+                None => {
+                    let comp = self.compatible_at(i, &lam, &d, tol);
+                    if comp.len() != 1 {
+                        return None;
+                    }
+                    classes.push(comp[0]);
+                }
+            }
+        }
+        Some(classes)
+    }
+
+    /// Handles a transition point: finds the neighbouring pieces that continue the path,
+    /// records the events and moves onto the chosen piece.
+    pub(super) fn transit(
+        &mut self,
+        cur: CurrentPiece,
+        pt: Point,
+        crossing: Vec<Guard>,
+    ) -> Result<StepOutcome> {
+        let scale = self.force_scale(&pt);
+        let tol = self.opts.zero_tol * scale;
+        let mut nodes: Vec<usize> = crossing.iter().map(|g| g.node).collect();
+        for GuardRow {
+            guard: g, value: v, ..
+        } in self.guard_table(&cur.classes, &pt, None)
+        {
+            if v <= tol {
+                nodes.push(g.node);
+            }
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        let pt = self.snap_to_vertex(pt, tol)?;
+        let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
+        let mut cands = self.continuations(&pt, &cur.classes, &nodes, back, false)?;
+        if cands.is_empty() {
+            cands = self.continuations(&pt, &cur.classes, &nodes, back, true)?;
+        }
+        self.close_piece(&pt);
+        let (events_start, pieces_len, last_dir, sigma) = {
+            let tr = self.trace.as_ref().expect("started");
+            (tr.events.len(), tr.pieces.len(), tr.last_dir, tr.sigma)
+        };
+        if cands.is_empty() {
+            return Err(Error::Numerical(format!(
+                "no neighbouring piece continues the path at alpha = {:e} (nodes {:?})",
+                pt.alpha,
+                nodes.iter().map(|i| i + 1).collect::<Vec<_>>()
+            )));
+        }
+        let bifurcation = cands.len() > 1;
+        let choice = if bifurcation {
+            let keep: Vec<usize> = (0..cands.len())
+                .filter(|&k| cands[k].orientation == sigma)
+                .collect();
+            if keep.len() == 1 { Some(keep[0]) } else { None }
+        } else {
+            Some(0)
+        };
+        let m = 2 * self.problem.p();
+        let branches: Vec<Branch> = cands
+            .iter()
+            .map(|c| Branch {
+                classes: c.classes.clone(),
+                direction: sign(if c.t[m].abs() <= 1e-14 { 0.0 } else { c.t[m] }),
+                orientation_preserving: c.orientation == sigma,
+            })
+            .collect();
+        let pending = PendingJoin {
+            point: pt,
+            from: cur.classes.clone(),
+            cands,
+            events_start,
+            pieces_len,
+            last_dir,
+            bifurcation,
+        };
+        {
+            let tr = self.trace.as_mut().expect("started");
+            tr.branches = if bifurcation { branches } else { Vec::new() };
+            tr.transitions += 1;
+        }
+        match choice {
+            Some(k) => {
+                let out = self.apply(&pending, k)?;
+                self.trace.as_mut().expect("started").pending = Some(pending);
+                Ok(out)
+            }
+            None => {
+                // Stop at the bifurcation point; its events are recorded when the caller
+                // chooses a branch.
+                let tr = self.trace.as_mut().expect("started");
+                tr.cur.lam = pending.point.lam.clone();
+                tr.cur.alpha = pending.point.alpha;
+                tr.pending = Some(pending);
+                Ok(self.finish(EndReason::Bifurcation))
+            }
+        }
+    }
+
+    /// At a point where every node is at the vertex (`λ = 0`, `q(α) = (g, 0)`: the load
+    /// passes through the state of zero contact forces), the exit point found from one
+    /// guard carries that guard's rounding; the exact point is `λ = 0` at the α that
+    /// minimises `‖q(α) − (g, 0)‖` (closed form for an affine load). Other points are
+    /// returned unchanged.
+    pub(super) fn snap_to_vertex(&mut self, pt: Point, tol: f64) -> Result<Point> {
+        let p = self.problem.p();
+        if inf_norm(&pt.lam) > tol || (0..p).any(|i| self.compatible(i, &pt, tol).len() < 4) {
+            return Ok(pt);
+        }
+        let m = 2 * p;
+        let alpha = if self.load.is_affine() {
+            let qg = shift_gap(&pt.q, self.problem.gap());
+            let (num, den) = qg
+                .iter()
+                .zip(&pt.dq)
+                .fold((0.0, 0.0), |(a, b), (x, y)| (a + x * y, b + y * y));
+            if den > 0.0 {
+                pt.alpha - num / den
+            } else {
+                pt.alpha
+            }
+        } else {
+            pt.alpha
+        };
+        let snapped = self.point_at(vec![0.0; m], alpha)?;
+        let qg = shift_gap(&snapped.q, self.problem.gap());
+        if self.problem.default_r() * inf_norm(&qg) <= tol {
+            Ok(snapped)
+        } else {
+            Ok(pt)
+        }
+    }
+
+    /// Moves onto candidate `k` of a pending transition and records its events.
+    pub(super) fn apply(&mut self, pend: &PendingJoin, k: usize) -> Result<StepOutcome> {
+        let m = 2 * self.problem.p();
+        let cand = pend.cands[k].clone();
+        let pt = pend.point.clone();
+        let dir = if cand.t[m].abs() <= 1e-14 {
+            0
+        } else {
+            sign(cand.t[m])
+        };
+        let fold = dir != 0 && pend.last_dir != 0 && dir != pend.last_dir;
+        let scale = self.force_scale(&pt);
+        let a_s = self.alpha_scale();
+        let p = self.problem.p();
+        let snapshot = self.load.snapshot(pt.alpha)?;
+        let tr = self.trace.as_mut().expect("started");
+        tr.events.truncate(pend.events_start);
+        tr.event_loads.truncate(pend.events_start);
+        tr.pieces.truncate(pend.pieces_len);
+        let transition = tr.events.last().map(|e| e.transition + 1).unwrap_or(0);
+        for i in 0..cand.classes.len() {
+            if cand.classes[i] != pend.from[i] {
+                let index = tr.events.len();
+                tr.events.push(Event {
+                    index,
+                    transition,
+                    alpha: pt.alpha,
+                    node: i,
+                    from: pend.from[i],
+                    to: cand.classes[i],
+                    fold,
+                    bifurcation: pend.bifurcation,
+                    lambda_n: pt.lam[..p].to_vec(),
+                    lambda_t: pt.lam[p..].to_vec(),
+                    classes: cand.classes.clone(),
+                });
+                tr.event_loads.push(snapshot.clone());
+            }
+        }
+        tr.pieces.push(PieceRecord {
+            classes: cand.classes.clone(),
+            alpha_from: pt.alpha,
+            alpha_to: pt.alpha,
+            lambda_from: pt.lam.clone(),
+            lambda_to: pt.lam.clone(),
+            direction: dir,
+            orientation: cand.orientation,
+            det_sign: cand.det_sign,
+        });
+        if dir != 0 {
+            tr.last_dir = dir;
+        } else {
+            tr.last_dir = pend.last_dir;
+        }
+        let same_point = tr.cur.alpha == pt.alpha
+            && tr
+                .cur
+                .lam
+                .iter()
+                .zip(&pt.lam)
+                .all(|(a, b)| (a - b).abs() <= 1e-14 * scale);
+        tr.zero_steps = if same_point { tr.zero_steps + 1 } else { 0 };
+        tr.cur = CurrentPiece {
+            classes: cand.classes.clone(),
+            lam: pt.lam.clone(),
+            alpha: pt.alpha,
+            t: cand.t.clone(),
+            lu: cand.lu.clone(),
+            scales: cand.scales,
+        };
+        let events = pend.events_start..tr.events.len();
+        let closed = tr.entries.iter().any(|e| {
+            e.classes == cand.classes
+                && (e.alpha - pt.alpha).abs() <= 1e-9 * a_s
+                && e.lam
+                    .iter()
+                    .zip(&pt.lam)
+                    .all(|(x, y)| (x - y).abs() <= 1e-9 * scale)
+        });
+        tr.entries.push(PieceEntry {
+            classes: cand.classes.clone(),
+            lam: pt.lam.clone(),
+            alpha: pt.alpha,
+        });
+        if closed {
+            tr.end = Some(EndReason::ClosedLoop);
+        } else if tr.zero_steps > 16 {
+            tr.end = Some(EndReason::Failed(format!(
+                "the path cycles between pieces at alpha = {:e} without moving",
+                pt.alpha
+            )));
+        }
+        Ok(StepOutcome::Transition {
+            events,
+            fold,
+            bifurcation: pend.bifurcation,
+        })
+    }
+
+    /// Continue along candidate `k` of [`Path::branches`] instead of the one taken (or
+    /// after the path stopped with [`EndReason::Bifurcation`]). Only allowed directly after
+    /// the bifurcation step. Errors: not started, no bifurcation pending, `k` out of range.
+    pub fn choose_branch(&mut self, k: usize) -> Result<()> {
+        let tr = self
+            .trace
+            .as_mut()
+            .ok_or_else(|| Error::Usage("the path has not been started".into()))?;
+        let Some(pend) = tr.pending.take() else {
+            return Err(Error::Usage(
+                "no bifurcation is pending: choose a branch directly after the step that found it"
+                    .into(),
+            ));
+        };
+        if !pend.bifurcation {
+            tr.pending = Some(pend);
+            return Err(Error::Usage(
+                "the last transition was not a bifurcation".into(),
+            ));
+        }
+        if k >= pend.cands.len() {
+            let n = pend.cands.len();
+            tr.pending = Some(pend);
+            return Err(Error::Usage(format!(
+                "branch {k} does not exist ({n} candidates)"
+            )));
+        }
+        if tr.end == Some(EndReason::Bifurcation) {
+            tr.end = None;
+        }
+        let res = self.apply(&pend, k);
+        let tr = self.trace.as_mut().expect("started");
+        tr.pending = Some(pend);
+        res.map(|_| ())
+    }
+}

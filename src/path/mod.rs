@@ -1,0 +1,617 @@
+//! The path tracer (SPEC §3–5).
+//!
+//! A [`Path`] starts at a solution found by the fixed-α solver and follows the solution
+//! curve piece by piece. [`Path::step`] advances to the next transition point (or the end
+//! of the window) and says what happened; [`Path::run`] steps until the path ends.
+//!
+//! Everything the path reports is kept: the [`Event`]s (one per node that changes class,
+//! with the full state at the event), the [`PieceRecord`]s, and enough to answer
+//! [`Path::solutions_at`] for any α by one small solve on each stored piece.
+
+mod advance;
+mod join;
+mod query;
+mod roots;
+
+use advance::Exit;
+
+use std::sync::Arc;
+
+use crate::class::Class;
+use crate::error::{Error, Result};
+use crate::load::{BoundLoad, Load, LoadSnapshot};
+use crate::piece::{DenseLu, Guard, PieceConstants, PieceLu, displacement_gaps, shift_gap};
+use crate::problem::Problem;
+use crate::solve::{solve_fixed_alpha, solve_with_frozen};
+
+/// Options of a path. Build with [`PathOptions::window`] and adjust the fields.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathOptions {
+    /// α where tracing starts (default: `alpha_start` of the window).
+    pub alpha_start: f64,
+    /// α toward which the path is traced first. The window is
+    /// `[min(alpha_start, alpha_end), max(alpha_start, alpha_end)]`; the path ends when α
+    /// leaves it, on either side (after a fold it may come back out through the start).
+    pub alpha_end: f64,
+    /// Maximum number of transition points before the path stops with
+    /// [`EndReason::MaxSteps`] (default 10 000).
+    pub max_steps: usize,
+    /// Relative tolerance for "a guard is at zero" and "two nodes switch at once"
+    /// (default 1e-11, relative to the force scale of the current point; displacement
+    /// guards are compared after multiplication by [`Problem::default_r`]).
+    pub zero_tol: f64,
+}
+
+impl PathOptions {
+    /// Trace from `alpha_start` toward `alpha_end` (must differ, both finite).
+    pub fn window(alpha_start: f64, alpha_end: f64) -> Self {
+        Self {
+            alpha_start,
+            alpha_end,
+            max_steps: 10_000,
+            zero_tol: 1e-11,
+        }
+    }
+}
+
+/// Why a path ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EndReason {
+    /// α reached the edge of the window.
+    Window,
+    /// `max_steps` transition points were traced.
+    MaxSteps,
+    /// The path came back to a point and piece it had already traced.
+    ClosedLoop,
+    /// A non-smooth bifurcation with no unique orientation-preserving branch: choose one
+    /// with [`Path::choose_branch`] and step on.
+    Bifurcation,
+    /// A failure (load callback, numerics); the message says which. What was traced is kept.
+    Failed(String),
+}
+
+impl EndReason {
+    /// The exchange-format name: `"window"`, `"max_steps"`, `"closed_loop"`,
+    /// `"bifurcation"`, `"failed"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            EndReason::Window => "window",
+            EndReason::MaxSteps => "max_steps",
+            EndReason::ClosedLoop => "closed_loop",
+            EndReason::Bifurcation => "bifurcation",
+            EndReason::Failed(_) => "failed",
+        }
+    }
+}
+
+/// A point of the solution curve with everything a user reads.
+#[derive(Debug, Clone, PartialEq)]
+pub struct State {
+    /// The load parameter.
+    pub alpha: f64,
+    /// Displacements (n).
+    pub u: Vec<f64>,
+    /// Normal contact forces (p), ≤ 0 (compressive).
+    pub lambda_n: Vec<f64>,
+    /// Tangential contact forces (p).
+    pub lambda_t: Vec<f64>,
+    /// Class of every node on the piece this point is reported for.
+    pub classes: Vec<Class>,
+    /// `‖H‖∞ / scale`, see [`crate::piece::residual`].
+    pub residual: f64,
+}
+
+/// One node changing class at a transition point.
+///
+/// An event carries the contact forces at the point (2p numbers); the full state (u and
+/// the residual) costs one back-solve with the factor of A and is computed on request by
+/// [`Path::event_state`], so that tracing costs nothing proportional to n per event.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Event {
+    /// 0-based position in [`Path::events`].
+    pub index: usize,
+    /// 0-based index of the transition point (events of one degenerate transition share it).
+    pub transition: usize,
+    /// α of the transition point.
+    pub alpha: f64,
+    /// 0-based contact node (reports add 1).
+    pub node: usize,
+    /// Class before.
+    pub from: Class,
+    /// Class after.
+    pub to: Class,
+    /// α turns back here: the sign of dα/ds after differs from the sign before.
+    pub fold: bool,
+    /// More than one neighbouring piece continues the path here.
+    pub bifurcation: bool,
+    /// Normal contact forces at the transition point (p), ≤ 0.
+    pub lambda_n: Vec<f64>,
+    /// Tangential contact forces at the transition point (p).
+    pub lambda_t: Vec<f64>,
+    /// Classes of all nodes on the piece after the transition.
+    pub classes: Vec<Class>,
+}
+
+/// A candidate continuation at a transition point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// Classes of the piece.
+    pub classes: Vec<Class>,
+    /// Sign of dα/ds along it (0 for a vertical piece).
+    pub direction: i8,
+    /// True if it keeps the path's orientation (SPEC §4).
+    pub orientation_preserving: bool,
+}
+
+/// A traced smooth piece.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PieceRecord {
+    /// Classes of all nodes on the piece.
+    pub classes: Vec<Class>,
+    /// α where the path entered the piece.
+    pub alpha_from: f64,
+    /// α where the path left it (equal to `alpha_from` for a vertical piece).
+    pub alpha_to: f64,
+    /// Contact forces `(λν, λt)` (2p) where the path entered.
+    pub lambda_from: Vec<f64>,
+    /// Contact forces where the path left.
+    pub lambda_to: Vec<f64>,
+    /// Sign of dα/ds on the piece: +1, −1, or 0 for a vertical piece (a continuum of
+    /// solutions at one α).
+    pub direction: i8,
+    /// The path's orientation sign `sign det [J_S; tᵀ]` (constant along a path unless a
+    /// branch was chosen against it).
+    pub orientation: i8,
+    /// Sign of `det` of the square part `∂H/∂λ` of the piece Jacobian (0 if singular).
+    pub det_sign: i8,
+}
+
+/// A solution at a given α, as returned by [`Path::solutions_at`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solution {
+    /// Index of the piece in [`Path::pieces`] that gave it.
+    pub piece: usize,
+    /// The state.
+    pub state: State,
+    /// True when the piece is vertical at this α: then every point between the piece's
+    /// `lambda_from` and `lambda_to` is a solution too (a continuum).
+    pub continuum: bool,
+}
+
+/// What one [`Path::step`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum StepOutcome {
+    /// A transition point was passed: `events` indexes [`Path::events`] (one per node
+    /// that changed class, in node order).
+    Transition {
+        /// The new events.
+        events: std::ops::Range<usize>,
+        /// α turns back here.
+        fold: bool,
+        /// Several pieces continue here; the path took the unique orientation-preserving
+        /// one (see [`Path::branches`]).
+        bifurcation: bool,
+    },
+    /// The path ended (it may be resumed after [`EndReason::Bifurcation`] by choosing a
+    /// branch).
+    End(EndReason),
+}
+
+/// A path on a shared problem with its own load. `Send`, not `Sync`: one thread at a time.
+pub struct Path {
+    problem: Arc<Problem>,
+    load: BoundLoad,
+    opts: PathOptions,
+    trace: Option<Trace>,
+}
+
+/// The traced data and the current position.
+struct Trace {
+    start: State,
+    events: Vec<Event>,
+    pieces: Vec<PieceRecord>,
+    cur: CurrentPiece,
+    end: Option<EndReason>,
+    /// The path's orientation σ.
+    sigma: i8,
+    /// Sign of dα/ds on the last non-vertical piece.
+    last_dir: i8,
+    transitions: usize,
+    /// Consecutive transitions at the same point (guards against cycling in place).
+    zero_steps: usize,
+    /// The load at each event (index as `events`), for [`Path::event_state`].
+    event_loads: Vec<LoadSnapshot>,
+    /// Entry points of the pieces: (classes, λ, α), for closed-loop detection.
+    entries: Vec<PieceEntry>,
+    /// The last transition, kept while a branch may still be chosen there.
+    pending: Option<PendingJoin>,
+    branches: Vec<Branch>,
+}
+
+/// Position on the current piece.
+#[derive(Clone)]
+struct CurrentPiece {
+    classes: Vec<Class>,
+    lam: Vec<f64>,
+    alpha: f64,
+    /// Tangent (λ̇, α̇), unit in scaled coordinates, oriented along the path.
+    t: Vec<f64>,
+    /// Factorisation of the piece Jacobian in scaled coordinates, with the scales.
+    lu: Arc<PieceLu>,
+    scales: JacobianScaling,
+}
+
+/// A transition point with its continuations, kept until the next step.
+struct PendingJoin {
+    point: Point,
+    from: Vec<Class>,
+    cands: Vec<Candidate>,
+    events_start: usize,
+    pieces_len: usize,
+    last_dir: i8,
+    bifurcation: bool,
+}
+
+#[derive(Clone)]
+struct Point {
+    lam: Vec<f64>,
+    alpha: f64,
+    q: Vec<f64>,
+    dq: Vec<f64>,
+}
+
+#[derive(Clone)]
+struct Candidate {
+    classes: Vec<Class>,
+    t: Vec<f64>,
+    orientation: i8,
+    det_sign: i8,
+    lu: Arc<PieceLu>,
+    scales: JacobianScaling,
+}
+
+/// The scaling of a piece Jacobian: λ is measured in units of `force`, α in units of
+/// `alpha`, so that the tangent is a unit vector in scaled coordinates.
+#[derive(Clone, Copy)]
+struct JacobianScaling {
+    force: f64,
+    alpha: f64,
+}
+
+/// Where the path entered a piece (for closed-loop detection).
+struct PieceEntry {
+    classes: Vec<Class>,
+    lam: Vec<f64>,
+    alpha: f64,
+}
+
+fn sign(x: f64) -> i8 {
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Largest number of neighbouring pieces enumerated at one transition point (the product
+/// over the nodes at a class boundary of the number of classes that fit there; nodes at
+/// the vertex are handled by the directional problem instead).
+const MAX_CANDIDATE_PIECES: usize = 4096;
+
+impl Path {
+    /// Binds a load to a problem. Computes the condensed load vectors (one back-solve per
+    /// basis vector). Errors: load length ≠ n; window bounds not finite or equal;
+    /// `zero_tol` not in (0, 1e-3].
+    pub fn new(problem: Arc<Problem>, load: Load, opts: PathOptions) -> Result<Path> {
+        if !opts.alpha_start.is_finite()
+            || !opts.alpha_end.is_finite()
+            || opts.alpha_start == opts.alpha_end
+        {
+            return Err(Error::InvalidParameter(format!(
+                "alpha window [{}, {}] must be finite with distinct ends",
+                opts.alpha_start, opts.alpha_end
+            )));
+        }
+        if !(opts.zero_tol > 0.0 && opts.zero_tol <= 1e-3) {
+            return Err(Error::InvalidParameter(format!(
+                "zero_tol = {} must be in (0, 1e-3]",
+                opts.zero_tol
+            )));
+        }
+        let load = BoundLoad::new(load, problem.delassus())?;
+        Ok(Path {
+            problem,
+            load,
+            opts,
+            trace: None,
+        })
+    }
+
+    /// The problem.
+    pub fn problem(&self) -> &Arc<Problem> {
+        &self.problem
+    }
+
+    /// The options.
+    pub fn options(&self) -> &PathOptions {
+        &self.opts
+    }
+
+    fn window(&self) -> (f64, f64) {
+        let (a, b) = (self.opts.alpha_start, self.opts.alpha_end);
+        (a.min(b), a.max(b))
+    }
+
+    fn alpha_scale(&self) -> f64 {
+        (self.opts.alpha_end - self.opts.alpha_start).abs()
+    }
+
+    fn consts(&self) -> PieceConstants<'_> {
+        PieceConstants::of(&self.problem)
+    }
+
+    fn point_at(&mut self, lam: Vec<f64>, alpha: f64) -> Result<Point> {
+        let (q, dq) = self.load.q(alpha, self.problem.delassus())?;
+        Ok(Point { lam, alpha, q, dq })
+    }
+
+    /// Force scale of a point: max(‖λ‖∞, r0 ‖q − (g, 0)‖∞, r0 ‖q'‖∞ |α_end − α_start|).
+    /// The last term keeps the scale meaningful where the load passes through zero.
+    fn force_scale(&self, pt: &Point) -> f64 {
+        let r0 = self.problem.default_r();
+        let qg = shift_gap(&pt.q, self.problem.gap());
+        inf_norm(&pt.lam)
+            .max(r0 * inf_norm(&qg))
+            .max(r0 * inf_norm(&pt.dq) * self.alpha_scale())
+            .max(1e-300)
+    }
+
+    fn state(&mut self, lam: &[f64], alpha: f64, classes: &[Class]) -> Result<State> {
+        // One back-solve of f + Bᵀλ: forming u as A⁻¹f + (A⁻¹Bᵀ)λ instead would cancel
+        // (the free displacement under the load is often orders of magnitude larger than
+        // u) and lose the residual's accuracy.
+        let f = self.load.force(alpha)?;
+        Ok(self.state_with_force(lam, alpha, classes, f))
+    }
+
+    fn state_with_force(&self, lam: &[f64], alpha: f64, classes: &[Class], f: Vec<f64>) -> State {
+        let u = self.problem.delassus().displacement(&f, lam);
+        let residual = crate::piece::residual(&self.problem, &u, lam, &f);
+        let p = self.problem.p();
+        State {
+            alpha,
+            u,
+            lambda_n: lam[..p].to_vec(),
+            lambda_t: lam[p..].to_vec(),
+            classes: classes.to_vec(),
+            residual,
+        }
+    }
+
+    /// Tangent of piece `classes` at `pt` in raw coordinates, from the factorisation of
+    /// the Jacobian in scaled coordinates (λ/S, α/A) where the tangent is a unit vector.
+    /// Returns (t, factorisation, scaling) or None when the Jacobian has rank < 2p.
+    fn tangent(
+        &self,
+        classes: &[Class],
+        pt: &Point,
+        scale: f64,
+    ) -> Option<(Vec<f64>, PieceLu, JacobianScaling)> {
+        let c = self.consts();
+        let m = 2 * c.p;
+        let qg = shift_gap(&pt.q, self.problem.gap());
+        let (mut js, _) = c.jacobian(self.problem.delassus().w(), classes, &qg, &pt.dq, pt.alpha);
+        let a_s = self.alpha_scale();
+        for r in 0..m {
+            for col in 0..m {
+                js[(r, col)] *= scale;
+            }
+            js[(r, m)] *= a_s;
+        }
+        let lu = PieceLu::new(js.as_ref())?;
+        let mut t = lu.t.clone();
+        for v in t.iter_mut().take(m) {
+            *v *= scale;
+        }
+        t[m] *= a_s;
+        Some((
+            t,
+            lu,
+            JacobianScaling {
+                force: scale,
+                alpha: a_s,
+            },
+        ))
+    }
+
+    /// Starts (or restarts) the path at `alpha` with the fixed-α solver, from `guess`
+    /// (`(λν, λt)`, 2p values) or from zero forces. Clears events and pieces.
+    /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
+    /// fails, the load fails, no piece leaves the start point toward `alpha_end`.
+    pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
+        self.trace = None;
+        let (lo, hi) = self.window();
+        if !(alpha >= lo && alpha <= hi) {
+            return Err(Error::InvalidParameter(format!(
+                "start alpha = {alpha} is outside the window [{lo}, {hi}]"
+            )));
+        }
+        let m = 2 * self.problem.p();
+        if let Some(g) = guess {
+            if g.len() != m {
+                return Err(Error::Dimension(format!(
+                    "initial guess has {} values, expected 2p = {m}",
+                    g.len()
+                )));
+            }
+            if let Some(i) = g.iter().position(|v| !v.is_finite()) {
+                return Err(Error::NonFinite(format!(
+                    "initial guess entry {} is {}",
+                    i + 1,
+                    g[i]
+                )));
+            }
+        }
+        let pt = self.point_at(vec![0.0; m], alpha)?;
+        let qg = shift_gap(&pt.q, self.problem.gap());
+        let lam = solve_fixed_alpha(&self.problem, &qg, guess, alpha)?;
+        let pt = Point { lam, ..pt };
+        let tol = self.opts.zero_tol * self.force_scale(&pt);
+        let p = self.problem.p();
+        let mut fixed = vec![Class::Open; p];
+        let mut nodes = Vec::new();
+        for i in 0..p {
+            let comp = self.compatible(i, &pt, tol);
+            match comp.len() {
+                0 => {
+                    return Err(Error::SolveFailed {
+                        alpha,
+                        message: format!("node {} fits no class at the computed point", i + 1),
+                    });
+                }
+                1 => fixed[i] = comp[0],
+                _ => nodes.push(i),
+            }
+        }
+        let want = sign(self.opts.alpha_end - self.opts.alpha_start);
+        let mut cands = self.continuations(&pt, &fixed, &nodes, None, false)?;
+        if cands.is_empty() {
+            cands = self.continuations(&pt, &fixed, &nodes, None, true)?;
+        }
+        let ms = 2 * p;
+        let pick = cands
+            .iter()
+            .position(|c| sign(c.t[ms]) == want)
+            .or_else(|| cands.iter().position(|c| c.t[ms].abs() <= 1e-14));
+        let Some(k) = pick else {
+            return Err(Error::Numerical(format!(
+                "no piece leaves the start point alpha = {alpha} toward alpha_end = {}",
+                self.opts.alpha_end
+            )));
+        };
+        let cand = cands[k].clone();
+        let start = self.state(&pt.lam, alpha, &cand.classes)?;
+        let dir = sign(cand.t[ms]);
+        let piece = PieceRecord {
+            classes: cand.classes.clone(),
+            alpha_from: alpha,
+            alpha_to: alpha,
+            lambda_from: pt.lam.clone(),
+            lambda_to: pt.lam.clone(),
+            direction: dir,
+            orientation: cand.orientation,
+            det_sign: cand.det_sign,
+        };
+        self.trace = Some(Trace {
+            start,
+            events: Vec::new(),
+            event_loads: Vec::new(),
+            pieces: vec![piece],
+            entries: vec![PieceEntry {
+                classes: cand.classes.clone(),
+                lam: pt.lam.clone(),
+                alpha,
+            }],
+            cur: CurrentPiece {
+                classes: cand.classes,
+                lam: pt.lam,
+                alpha,
+                t: cand.t,
+                lu: cand.lu,
+                scales: cand.scales,
+            },
+            end: None,
+            sigma: cand.orientation,
+            last_dir: if dir != 0 { dir } else { want },
+            transitions: 0,
+            zero_steps: 0,
+            pending: None,
+            branches: Vec::new(),
+        });
+        Ok(())
+    }
+
+    fn trace_ref(&self) -> Result<&Trace> {
+        self.trace
+            .as_ref()
+            .ok_or_else(|| Error::Usage("the path has not been started (call start first)".into()))
+    }
+
+    /// Advances to the next transition point or to the end of the path.
+    /// Errors: not started ([`Error::Usage`]), load failure ([`Error::Load`]; the path then
+    /// ends with [`EndReason::Failed`] and keeps what it traced), numerical failure
+    /// (likewise).
+    pub fn step(&mut self) -> Result<StepOutcome> {
+        let tr = self.trace_ref()?;
+        if let Some(r) = &tr.end {
+            return Ok(StepOutcome::End(r.clone()));
+        }
+        match self.step_inner() {
+            Ok(o) => Ok(o),
+            Err(e) => {
+                if let Some(tr) = self.trace.as_mut() {
+                    tr.end = Some(EndReason::Failed(e.to_string()));
+                    tr.pending = None;
+                }
+                Err(e)
+            }
+        }
+    }
+
+    fn finish(&mut self, reason: EndReason) -> StepOutcome {
+        let tr = self.trace.as_mut().expect("started");
+        tr.end = Some(reason.clone());
+        StepOutcome::End(reason)
+    }
+
+    fn step_inner(&mut self) -> Result<StepOutcome> {
+        {
+            let tr = self.trace.as_mut().expect("started");
+            tr.pending = None;
+            tr.branches.clear();
+            if tr.transitions >= self.opts.max_steps {
+                return Ok(self.finish(EndReason::MaxSteps));
+            }
+        }
+        let cur = self.trace.as_ref().expect("started").cur.clone();
+        let m = 2 * self.problem.p();
+        let vertical = cur.t[m].abs() <= 1e-14;
+        let exit = if self.load.is_affine() || vertical {
+            self.exit_linear(&cur)?
+        } else {
+            self.exit_graph(&cur)?
+        };
+        match exit {
+            Exit::Window(pt) => {
+                self.close_piece(&pt);
+                let tr = self.trace.as_mut().expect("started");
+                tr.cur.lam = pt.lam;
+                tr.cur.alpha = pt.alpha;
+                Ok(self.finish(EndReason::Window))
+            }
+            Exit::Guards(pt, crossing) => self.transit(cur, pt, crossing),
+        }
+    }
+
+    fn close_piece(&mut self, pt: &Point) {
+        let tr = self.trace.as_mut().expect("started");
+        let last = tr.pieces.last_mut().expect("one piece");
+        last.alpha_to = pt.alpha;
+        last.lambda_to = pt.lam.clone();
+    }
+
+    /// Steps until the path ends; returns why.
+    pub fn run(&mut self) -> Result<EndReason> {
+        loop {
+            if let StepOutcome::End(r) = self.step()? {
+                return Ok(r);
+            }
+        }
+    }
+}

@@ -1,0 +1,132 @@
+//! Queries on a traced path: the records kept, the state at an event (one back-solve)
+//! and every traced solution at a given α.
+
+use super::*;
+
+impl Path {
+    /// True after a successful [`Path::start`].
+    pub fn is_started(&self) -> bool {
+        self.trace.is_some()
+    }
+
+    /// Why the path ended, if it did.
+    pub fn end_reason(&self) -> Option<&EndReason> {
+        self.trace.as_ref().and_then(|t| t.end.as_ref())
+    }
+
+    /// The start point (after [`Path::start`]).
+    pub fn start_state(&self) -> Option<&State> {
+        self.trace.as_ref().map(|t| &t.start)
+    }
+
+    /// The events so far (empty before the start).
+    pub fn events(&self) -> &[Event] {
+        self.trace
+            .as_ref()
+            .map(|t| t.events.as_slice())
+            .unwrap_or(&[])
+    }
+
+    /// The full state at event `k`: u by one back-solve of `f(α) + Bᵀλ`, and the residual.
+    /// Never calls the load's closures: the load at the event was kept when it was found
+    /// (nothing for an affine load, the weights for a basis load, f(α) for a general one).
+    /// Errors: not started, `k` out of range.
+    pub fn event_state(&self, k: usize) -> Result<State> {
+        let tr = self.trace_ref()?;
+        let e = tr.events.get(k).ok_or_else(|| {
+            Error::Usage(format!(
+                "event {k} does not exist ({} events)",
+                tr.events.len()
+            ))
+        })?;
+        let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
+        let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
+        Ok(self.state_with_force(&lam, e.alpha, &e.classes, f))
+    }
+
+    /// The pieces so far (the last one is the current piece; empty before the start).
+    pub fn pieces(&self) -> &[PieceRecord] {
+        self.trace
+            .as_ref()
+            .map(|t| t.pieces.as_slice())
+            .unwrap_or(&[])
+    }
+
+    /// The current point (u by one back-solve). Errors: not started, load failure.
+    pub fn current(&mut self) -> Result<State> {
+        let cur = self.trace_ref()?.cur.clone();
+        self.state(&cur.lam, cur.alpha, &cur.classes)
+    }
+
+    /// Candidate continuations at the last transition point (empty unless it was a
+    /// bifurcation and no step has been taken since).
+    pub fn branches(&self) -> &[Branch] {
+        self.trace
+            .as_ref()
+            .map(|t| t.branches.as_slice())
+            .unwrap_or(&[])
+    }
+
+    /// Every traced solution at `alpha`: one per traced piece whose α-range contains it
+    /// (several past a fold), each by one small solve on the stored piece plus one
+    /// back-solve for u. Points shared by two pieces (transition points) are reported
+    /// once. Empty if the traced path never reached `alpha`. Errors: not started, load
+    /// failure.
+    pub fn solutions_at(&mut self, alpha: f64) -> Result<Vec<Solution>> {
+        let pieces = self.trace_ref()?.pieces.clone();
+        let m = 2 * self.problem.p();
+        let a_tol = 1e-12 * self.alpha_scale().max(alpha.abs());
+        let pt0 = self.point_at(vec![0.0; m], alpha)?;
+        let qg = shift_gap(&pt0.q, self.problem.gap());
+        let mut out: Vec<Solution> = Vec::new();
+        for (k, pc) in pieces.iter().enumerate() {
+            let (lo, hi) = (
+                pc.alpha_from.min(pc.alpha_to),
+                pc.alpha_from.max(pc.alpha_to),
+            );
+            if !(alpha >= lo - a_tol && alpha <= hi + a_tol) {
+                continue;
+            }
+            let mut lams = Vec::new();
+            let continuum = pc.direction == 0;
+            if continuum {
+                lams.push(pc.lambda_from.clone());
+                lams.push(pc.lambda_to.clone());
+            } else if (alpha - pc.alpha_from).abs() <= a_tol {
+                lams.push(pc.lambda_from.clone());
+            } else if (alpha - pc.alpha_to).abs() <= a_tol {
+                lams.push(pc.lambda_to.clone());
+            } else {
+                let c = self.consts();
+                let w = self.problem.delassus().w();
+                let lu = DenseLu::new(c.piece_matrix(w, &pc.classes).as_ref());
+                lams.push(lu.solve(&c.piece_rhs(&pc.classes, &qg)));
+            }
+            for lam in lams {
+                let pt = Point {
+                    lam: lam.clone(),
+                    ..pt0.clone()
+                };
+                let scale = self.force_scale(&pt);
+                let dup = out.iter().any(|s| {
+                    s.state
+                        .lambda_n
+                        .iter()
+                        .chain(&s.state.lambda_t)
+                        .zip(&lam)
+                        .all(|(a, b)| (a - b).abs() <= 1e-9 * scale)
+                });
+                if dup {
+                    continue;
+                }
+                let state = self.state(&lam, alpha, &pc.classes)?;
+                out.push(Solution {
+                    piece: k,
+                    state,
+                    continuum,
+                });
+            }
+        }
+        Ok(out)
+    }
+}

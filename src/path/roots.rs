@@ -1,0 +1,131 @@
+//! Scalar root finding and bounds for the nonlinear steps: the minimum of a cubic
+//! Hermite interpolant (a double crossing inside a step is not skipped) and Brent's
+//! method for the crossing itself.
+
+/// Minimum over [0, 1] of the cubic Hermite interpolant with values v0, v1 and
+/// derivatives m0, m1 (with respect to the unit interval).
+pub(super) fn hermite_min(v0: f64, v1: f64, m0: f64, m1: f64) -> f64 {
+    // p(s) = v0 h00 + m0 h10 + v1 h01 + m1 h11; p'(s) = a s² + b s + c
+    let a = 6.0 * v0 + 3.0 * m0 - 6.0 * v1 + 3.0 * m1;
+    let b = -6.0 * v0 - 4.0 * m0 + 6.0 * v1 - 2.0 * m1;
+    let c = m0;
+    let p = |s: f64| {
+        let s2 = s * s;
+        let s3 = s2 * s;
+        v0 * (2.0 * s3 - 3.0 * s2 + 1.0)
+            + m0 * (s3 - 2.0 * s2 + s)
+            + v1 * (-2.0 * s3 + 3.0 * s2)
+            + m1 * (s3 - s2)
+    };
+    let mut best = v0.min(v1);
+    let mut try_s = |s: f64| {
+        if s > 0.0 && s < 1.0 {
+            best = best.min(p(s));
+        }
+    };
+    if a.abs() < 1e-300 {
+        if b != 0.0 {
+            try_s(-c / b);
+        }
+    } else {
+        let disc = b * b - 4.0 * a * c;
+        if disc >= 0.0 {
+            let sq = disc.sqrt();
+            try_s((-b + sq) / (2.0 * a));
+            try_s((-b - sq) / (2.0 * a));
+        }
+    }
+    best
+}
+
+/// Brent's method for a root of `f` in [a, b] with `f(a) > 0 > f(b)` (or any sign change),
+/// to machine precision in the argument.
+pub(super) fn brent(a: f64, b: f64, fa: f64, fb: f64, mut f: impl FnMut(f64) -> f64) -> f64 {
+    let (mut a, mut b, mut fa, mut fb) = (a, b, fa, fb);
+    if fa.abs() < fb.abs() {
+        std::mem::swap(&mut a, &mut b);
+        std::mem::swap(&mut fa, &mut fb);
+    }
+    let (mut c, mut fc) = (a, fa);
+    let mut d = b - a;
+    let mut e = d;
+    for _ in 0..200 {
+        if fb == 0.0 {
+            return b;
+        }
+        if (fb > 0.0) == (fc > 0.0) {
+            c = a;
+            fc = fa;
+            d = b - a;
+            e = d;
+        }
+        if fc.abs() < fb.abs() {
+            a = b;
+            b = c;
+            c = a;
+            fa = fb;
+            fb = fc;
+            fc = fa;
+        }
+        let tol = 2.0 * f64::EPSILON * b.abs() + 1e-300;
+        let mid = 0.5 * (c - b);
+        if mid.abs() <= tol {
+            return b;
+        }
+        if e.abs() >= tol && fa.abs() > fb.abs() {
+            let s = fb / fa;
+            let (mut pp, mut qq);
+            if a == c {
+                pp = 2.0 * mid * s;
+                qq = 1.0 - s;
+            } else {
+                let q0 = fa / fc;
+                let r = fb / fc;
+                pp = s * (2.0 * mid * q0 * (q0 - r) - (b - a) * (r - 1.0));
+                qq = (q0 - 1.0) * (r - 1.0) * (s - 1.0);
+            }
+            if pp > 0.0 {
+                qq = -qq;
+            } else {
+                pp = -pp;
+            }
+            if 2.0 * pp < (3.0 * mid * qq - (tol * qq).abs()).min((e * qq).abs()) {
+                e = d;
+                d = pp / qq;
+            } else {
+                d = mid;
+                e = d;
+            }
+        } else {
+            d = mid;
+            e = d;
+        }
+        a = b;
+        fa = fb;
+        b += if d.abs() > tol { d } else { tol * mid.signum() };
+        fb = f(b);
+        if fb.is_nan() {
+            return b;
+        }
+    }
+    b
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn brent_finds_cubic_root() {
+        let f = |x: f64| 2.0 - x * x * x;
+        let r = brent(0.0, 2.0, f(0.0), f(2.0), f);
+        assert!((r - 2f64.cbrt()).abs() < 4.0 * f64::EPSILON);
+    }
+
+    #[test]
+    fn hermite_detects_dip() {
+        // p(s) = (s - 0.5)^2 - 0.01 : values 0.24 at both ends, slopes -1 and +1, min -0.01
+        assert!(hermite_min(0.24, 0.24, -1.0, 1.0) < -0.009);
+        assert!(hermite_min(1.0, 2.0, 1.0, 1.0) >= 1.0);
+    }
+}
