@@ -4,8 +4,9 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use fricont::path::{Path, PathOptions};
-use fricont_cli::casestudy::{seed_words, transition_rows};
+use fricont_cli::casestudy::seed_words;
 use fricont_exchange::generator::{RectSpec, generate};
+use fricont_exchange::report::transition_rows;
 
 fn main() {
     let arg = std::env::args().nth(1).unwrap_or_else(|| "{}".into());

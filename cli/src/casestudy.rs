@@ -31,6 +31,9 @@ use fricont::path::{EndReason, Path, PathOptions, State};
 use fricont::problem::Problem;
 use fricont_exchange::generator::{RectSpec, Side, generate};
 use fricont_exchange::io::CaseData;
+use fricont_exchange::report::{
+    PathReport, Timing, TransitionRow, events_csv, fmt_alpha, transition_rows,
+};
 use fricont_exchange::{Error, Result};
 
 /// What to run. `CaseStudyOptions::new(out)` gives the paper's case study.
@@ -82,25 +85,6 @@ impl Default for FoldVariant {
             alpha_query: None,
         }
     }
-}
-
-/// One row of the transition table (1-based numbers as in the paper).
-#[derive(Debug, Clone, PartialEq)]
-pub struct TransitionRow {
-    /// 1-based transition point (shared by the rows of a degenerate transition).
-    pub transition: usize,
-    /// α of the transition point.
-    pub alpha: f64,
-    /// 1-based contact node.
-    pub node: usize,
-    /// Class before.
-    pub from: Class,
-    /// Class after.
-    pub to: Class,
-    /// α turns back here.
-    pub fold: bool,
-    /// Several pieces continue the path here.
-    pub bifurcation: bool,
 }
 
 /// What the high-friction variant gave.
@@ -165,21 +149,6 @@ impl CaseStudyReport {
             let _ = writeln!(s, "  {}", f.display());
         }
         s
-    }
-}
-
-/// α with 14 significant digits in plain notation when reasonable (`0.28019791259766`),
-/// in scientific notation otherwise.
-pub fn fmt_alpha14(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let e = x.abs().log10().floor() as i32;
-    if (-4..15).contains(&e) {
-        let decimals = (13 - e).max(0) as usize;
-        format!("{x:.decimals$}")
-    } else {
-        format!("{x:.13e}")
     }
 }
 
@@ -1117,22 +1086,6 @@ fn trace(case: &CaseData, problem: Arc<Problem>, a0: f64, a1: f64) -> Result<Tra
     })
 }
 
-/// The transition rows of a path (1-based numbers).
-pub fn transition_rows(path: &Path) -> Vec<TransitionRow> {
-    path.events()
-        .iter()
-        .map(|e| TransitionRow {
-            transition: e.transition + 1,
-            alpha: e.alpha,
-            node: e.node + 1,
-            from: e.from,
-            to: e.to,
-            fold: e.fold,
-            bifurcation: e.bifurcation,
-        })
-        .collect()
-}
-
 /// The transition table in the paper's words, one line per event:
 /// "at transition point 6, α = 0.28019791259766, contact node 13 changes from no contact
 /// to contact, slip (slip+)". Folds and bifurcations are flagged at the end of the line.
@@ -1148,7 +1101,7 @@ pub fn seed_words(rows: &[TransitionRow]) -> String {
             s,
             "at transition point {}, α = {}, contact node {} changes from {} to {}{dir}",
             r.transition,
-            fmt_alpha14(r.alpha),
+            fmt_alpha(r.alpha),
             r.node,
             r.from.words(),
             r.to.words()
@@ -1220,58 +1173,33 @@ fn event_nodes(path: &Path) -> Vec<usize> {
     v
 }
 
-fn class_list(c: &[Class]) -> Value {
-    Value::Array(c.iter().map(|c| Value::from(c.name())).collect())
-}
-
-/// The path as JSON: the object of SPEC §8 plus every vertex's contact data.
+/// The path as JSON: the report of SPEC §8 ([`PathReport`], the one JSON writer of the
+/// project) extended with every vertex's contact data (`λν`, `λt`, `uν`, `ut` per node at
+/// the start and at each event, under `state`) and the units.
 fn path_json(path: &mut Path, case: &CaseData, setup_s: f64, trace_s: f64) -> Result<Value> {
-    let prob = path.problem().clone();
-    let cur = path.current()?;
-    let start = path
-        .start_state()
-        .cloned()
-        .ok_or_else(|| Error::Core(fricont::Error::Usage("path not started".into())))?;
+    let report = PathReport::from_path(path, Timing { setup_s, trace_s });
+    let mut v = serde_json::to_value(&report)
+        .map_err(|e| Error::Io(format!("cannot serialise the path: {e}")))?;
     let vertex = |s: &State| {
         let d = ContactData::from_state(s, case);
         json!({
-            "alpha": s.alpha, "classes": class_list(&s.classes), "residual": s.residual,
+            "alpha": s.alpha, "residual": s.residual,
             "lambda_n": d.lambda_n, "lambda_t": d.lambda_t, "u_n": d.u_n, "u_t": d.u_t,
         })
     };
-    let list = path.events().to_vec();
-    let mut events: Vec<Value> = Vec::with_capacity(list.len());
-    for e in &list {
-        let st = path.event_state(e.index)?;
-        events.push(json!({
-            "index": e.index + 1, "transition": e.transition + 1, "alpha": e.alpha,
-            "node": e.node + 1, "from": e.from.name(), "to": e.to.name(),
-            "fold": e.fold, "bifurcation": e.bifurcation, "residual": st.residual,
-            "state": vertex(&st),
-        }));
+    if let Some(start) = path.start_state().cloned() {
+        v["start"]["state"] = vertex(&start);
     }
-    let pieces: Vec<Value> = path
-        .pieces()
-        .iter()
-        .map(|r| {
-            json!({
-                "alpha_from": r.alpha_from, "alpha_to": r.alpha_to,
-                "classes": class_list(&r.classes), "direction": r.direction,
-                "orientation": r.orientation, "det_sign": r.det_sign,
-            })
-        })
-        .collect();
-    let opts = path.options();
-    Ok(json!({
-        "n": prob.n(), "p": prob.p(), "r": prob.r(),
-        "alpha_start": opts.alpha_start, "alpha_end": opts.alpha_end,
-        "start": vertex(&start),
-        "events": events,
-        "pieces": pieces,
-        "end": {"alpha": cur.alpha, "reason": path.end_reason().map(|r| r.name())},
-        "timing": {"setup_s": setup_s, "trace_s": trace_s},
-        "units": "lengths in L, stresses in E, nodal forces per unit thickness in E*L; lambda_n <= 0 compressive; u_n = N u = -u_y; u_t = T u = u_x; nodes 1-based",
-    }))
+    let list = path.events().to_vec();
+    if let Some(events) = v["events"].as_array_mut() {
+        for (e, ev) in list.iter().zip(events.iter_mut()) {
+            ev["state"] = vertex(&path.event_state(e.index)?);
+        }
+    }
+    v["units"] = json!(
+        "lengths in L, stresses in E, nodal forces per unit thickness in E*L; lambda_n <= 0 compressive; u_n = N u = -u_y; u_t = T u = u_x; nodes 1-based"
+    );
+    Ok(v)
 }
 
 /// The path's vertices (start, every transition point, end) as CSV: one row per vertex,
@@ -1318,24 +1246,6 @@ fn path_csv(path: &mut Path, case: &CaseData) -> Result<String> {
     Ok(s)
 }
 
-fn events_csv(rows: &[TransitionRow]) -> String {
-    let mut s = String::from("transition,alpha,node,from,to,fold,bifurcation\n");
-    for r in rows {
-        let _ = writeln!(
-            s,
-            "{},{:e},{},{},{},{},{}",
-            r.transition,
-            r.alpha,
-            r.node,
-            r.from.name(),
-            r.to.name(),
-            r.fold,
-            r.bifurcation
-        );
-    }
-    s
-}
-
 fn write(file: PathBuf, text: &str, files: &mut Vec<PathBuf>) -> Result<()> {
     std::fs::write(&file, text).map_err(io_err(&file))?;
     files.push(file);
@@ -1363,7 +1273,7 @@ fn header(spec: &RectSpec, end: &EndReason, path: &Path) -> String {
         path.events().len(),
         folds,
         end.name(),
-        fmt_alpha14(last)
+        fmt_alpha(last)
     )
 }
 
@@ -1589,7 +1499,7 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
         let _ = writeln!(
             table,
             "at α = {}: {} solutions on the traced path",
-            fmt_alpha14(a),
+            fmt_alpha(a),
             n_sol
         );
         for (k, s) in sols.iter().enumerate() {
@@ -1637,7 +1547,7 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
                 "F = {}: all {} solutions at α = {} (inside a fold region)",
                 spec.friction,
                 n_sol,
-                fmt_alpha14(a)
+                fmt_alpha(a)
             ),
             &out.join("solutions.svg"),
         )?;
@@ -1732,15 +1642,6 @@ mod tests {
         assert!(clip_pieces(std::slice::from_ref(&p), 2.0, 3.0).is_empty());
         let v = PieceLine { alpha_to: 1.0, ..p };
         assert_eq!(clip_pieces(std::slice::from_ref(&v), 0.5, 1.5).len(), 1);
-    }
-
-    #[test]
-    fn alpha_has_14_significant_digits() {
-        assert_eq!(fmt_alpha14(0.28019791259766), "0.28019791259766");
-        assert_eq!(fmt_alpha14(-0.5), "-0.50000000000000");
-        assert_eq!(fmt_alpha14(3.6), "3.6000000000000");
-        assert_eq!(fmt_alpha14(1.25e-7), "1.2500000000000e-7");
-        assert_eq!(fmt_alpha14(0.0), "0");
     }
 
     #[test]

@@ -3,8 +3,8 @@
 //! Both count nodes, events and transition points from 1, as the founding paper does.
 //! In JSON, α and every other number are written by `serde_json` in shortest round-trip
 //! form (reading the number back gives the same `f64`); a non-finite number (which a
-//! correct path never produces) is written as `null`. In the table, α is written with 14
-//! significant digits (`{:.13e}`).
+//! correct path never produces) is written as `null`. In the tables, α is written with 14
+//! significant digits by [`fmt_alpha`] (positional where readable, as the paper does).
 
 use std::fmt::Write as _;
 
@@ -350,9 +350,138 @@ pub fn path_json(path: &mut Path, timing: Timing) -> Value {
     serde_json::to_value(PathReport::from_path(path, timing)).unwrap_or(Value::Null)
 }
 
-/// α with 14 significant digits, e.g. `2.8019791259766e-1`.
+/// α with 14 significant digits: in positional notation where that is readable
+/// (magnitudes from 1e-4 to below 1e15: `0.28019791259766`, `-0.50000000000000`,
+/// `3.6000000000000`), in scientific notation otherwise (`1.2500000000000e-7`); `0` and
+/// non-finite values as Rust prints them. Reading the text back gives α to 5e-14 relative.
 pub fn fmt_alpha(alpha: f64) -> String {
-    format!("{alpha:.13e}")
+    if alpha == 0.0 || !alpha.is_finite() {
+        return format!("{alpha}");
+    }
+    let e = alpha.abs().log10().floor() as i32;
+    if (-4..15).contains(&e) {
+        let decimals = (13 - e).max(0) as usize;
+        let s = format!("{alpha:.decimals$}");
+        // Rounding may carry into a new leading digit (9.99…95 → 10.000…): one digit
+        // fewer after the point keeps 14 significant digits.
+        let significant = s
+            .chars()
+            .filter(char::is_ascii_digit)
+            .skip_while(|&c| c == '0')
+            .count();
+        if significant > 14 && decimals > 0 {
+            let decimals = decimals - 1;
+            return format!("{alpha:.decimals$}");
+        }
+        s
+    } else {
+        format!("{alpha:.13e}")
+    }
+}
+
+/// One row of a transition table: one event, with 1-based numbers as in the paper.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TransitionRow {
+    /// 1-based transition point (shared by the rows of a degenerate transition).
+    pub transition: usize,
+    /// α of the transition point.
+    pub alpha: f64,
+    /// 1-based contact node.
+    pub node: usize,
+    /// Class before.
+    pub from: Class,
+    /// Class after.
+    pub to: Class,
+    /// α turns back here.
+    pub fold: bool,
+    /// Several pieces continue the path here.
+    pub bifurcation: bool,
+}
+
+impl TransitionRow {
+    /// The flags of the row: `fold`, `bifurcation` (space-separated, possibly empty).
+    pub fn flags(&self) -> String {
+        let mut flags = Vec::new();
+        if self.fold {
+            flags.push("fold");
+        }
+        if self.bifurcation {
+            flags.push("bifurcation");
+        }
+        flags.join(" ")
+    }
+}
+
+/// The transition rows of a path, one per event in path order (1-based numbers).
+pub fn transition_rows(path: &Path) -> Vec<TransitionRow> {
+    path.events()
+        .iter()
+        .map(|e| TransitionRow {
+            transition: e.transition + 1,
+            alpha: e.alpha,
+            node: e.node + 1,
+            from: e.from,
+            to: e.to,
+            fold: e.fold,
+            bifurcation: e.bifurcation,
+        })
+        .collect()
+}
+
+/// The rows of the transition table, as the CLI prints them (after a header line
+/// `k  alpha  node  before -> after  flags`), each ending with a newline.
+pub fn table_rows(rows: &[TransitionRow]) -> String {
+    let mut s = String::new();
+    for r in rows {
+        let change = format!("{} -> {}", r.from.name(), r.to.name());
+        let row = format!(
+            "{:>4}  {:>21}  {:>4}  {:<15}  {}",
+            r.transition,
+            fmt_alpha(r.alpha),
+            r.node,
+            change,
+            r.flags()
+        );
+        s.push_str(row.trim_end());
+        s.push('\n');
+    }
+    s
+}
+
+/// The events as CSV: `transition,alpha,node,from,to,fold,bifurcation`, α in shortest
+/// round-trip form, 1-based numbers.
+pub fn events_csv(rows: &[TransitionRow]) -> String {
+    let mut s = String::from("transition,alpha,node,from,to,fold,bifurcation\n");
+    for r in rows {
+        let _ = writeln!(
+            s,
+            "{},{:e},{},{},{},{},{}",
+            r.transition,
+            r.alpha,
+            r.node,
+            r.from.name(),
+            r.to.name(),
+            r.fold,
+            r.bifurcation
+        );
+    }
+    s
+}
+
+/// "1 event at 1 transition point", "3 events at 2 transition points".
+pub fn count_words(events: usize, transitions: usize) -> String {
+    let plural = |k: usize, w: &str| {
+        if k == 1 {
+            format!("{k} {w}")
+        } else {
+            format!("{k} {w}s")
+        }
+    };
+    format!(
+        "{} at {}",
+        plural(events, "event"),
+        plural(transitions, "transition point")
+    )
 }
 
 /// Counts of each class, e.g. `"12 open, 18 stick, 0 slip+, 0 slip-"`.
@@ -419,26 +548,7 @@ pub fn table(path: &mut Path, timing: Option<Timing>) -> String {
         "{:>4}  {:>21}  {:>4}  before -> after  flags",
         "k", "alpha", "node"
     );
-    for e in path.events() {
-        let mut flags = Vec::new();
-        if e.fold {
-            flags.push("fold");
-        }
-        if e.bifurcation {
-            flags.push("bifurcation");
-        }
-        let change = format!("{} -> {}", e.from.name(), e.to.name());
-        let row = format!(
-            "{:>4}  {:>21}  {:>4}  {:<15}  {}",
-            e.transition + 1,
-            fmt_alpha(e.alpha),
-            e.node + 1,
-            change,
-            flags.join(" ")
-        );
-        s.push_str(row.trim_end());
-        s.push('\n');
-    }
+    s.push_str(&table_rows(&transition_rows(path)));
     let n_tp = path.events().last().map_or(0, |e| e.transition + 1);
     let alpha = end_alpha.map_or_else(|| "-".to_string(), fmt_alpha);
     let why = match &reason {
@@ -448,8 +558,8 @@ pub fn table(path: &mut Path, timing: Option<Timing>) -> String {
     };
     let _ = write!(
         s,
-        "{} events at {n_tp} transition points; end: alpha = {alpha}, reason {why}",
-        path.events().len()
+        "{}; end: alpha = {alpha}, reason {why}",
+        count_words(path.events().len(), n_tp)
     );
     if let Some(t) = timing {
         let ratio = if t.setup_s > 0.0 {
@@ -473,6 +583,14 @@ mod tests {
 
     #[test]
     fn alpha_has_fourteen_significant_digits() {
+        // Positional where readable, as the founding paper prints α.
+        assert_eq!(fmt_alpha(0.28019791259766), "0.28019791259766");
+        assert_eq!(fmt_alpha(-0.5), "-0.50000000000000");
+        assert_eq!(fmt_alpha(3.6), "3.6000000000000");
+        assert_eq!(fmt_alpha(1.25e-7), "1.2500000000000e-7");
+        assert_eq!(fmt_alpha(0.0), "0");
+        // A carry into a new leading digit keeps 14 digits.
+        assert_eq!(fmt_alpha(9.999999999999999), "10.000000000000");
         for &x in &[
             0.28019791259766_f64,
             -0.5,
@@ -480,15 +598,25 @@ mod tests {
             0.42934036865234,
             -1.234567890123456e-7,
             6.02214076e23,
+            123456.789012345678,
+            9.999999999999999,
+            0.000123456789012345,
         ] {
             let s = fmt_alpha(x);
-            let (mant, _) = s.split_once('e').unwrap();
-            let digits = mant.chars().filter(char::is_ascii_digit).count();
-            assert_eq!(digits, 14, "{s}");
+            let mant = s.split_once('e').map_or(s.as_str(), |(m, _)| m);
+            let digits: String = mant.chars().filter(char::is_ascii_digit).collect();
+            let significant = digits.trim_start_matches('0').len();
+            assert_eq!(significant, 14, "{s}");
             let back: f64 = s.parse().unwrap();
             assert!((back - x).abs() <= 5e-14 * x.abs(), "{s} vs {x}");
         }
-        assert_eq!(fmt_alpha(0.28019791259766), "2.8019791259766e-1");
+    }
+
+    #[test]
+    fn counts_are_in_good_english() {
+        assert_eq!(count_words(1, 1), "1 event at 1 transition point");
+        assert_eq!(count_words(3, 2), "3 events at 2 transition points");
+        assert_eq!(count_words(0, 0), "0 events at 0 transition points");
     }
 
     #[test]
