@@ -1,0 +1,390 @@
+"""fricont: exact path-following of discrete 2D contact problems with Coulomb friction.
+
+Hand over the stiffness ``A`` (n x n, symmetric positive definite), the contact matrices
+``N`` and ``T`` (p x n: row i gives the normal and the tangential displacement of contact
+node i), friction coefficients and a load path ``f(alpha)``; fricont traces the solution
+curve as ``alpha`` varies and reports every transition point, where a contact node changes
+between ``"open"`` (no contact), ``"stick"``, ``"slip+"`` and ``"slip-"``.
+
+Conventions (as the C and Rust APIs):
+
+* ``lambda_n <= 0`` is compressive, ``N u <= g`` is non-penetration (``g`` defaults to 0);
+* ``"slip+"`` slips with ``T u > 0`` and carries ``lambda_t = F * lambda_n``;
+* forces are in the units of ``A u``; ``r`` (the augmentation parameter) is force per
+  length and changes nothing in the solutions (default ``2p / trace(W)``);
+* node indices are 0-based in Python (the CLI's reports and ``to_dict()`` count from 1,
+  as the founding paper does);
+* residuals are ``||H||_inf`` relative to the largest magnitude among the terms of the
+  equations (a normwise backward error).
+
+Example::
+
+    import numpy as np, scipy.sparse as sp, fricont
+    A = sp.diags([2.0, 1.0]).tocsr()           # one node: normal dof 0, tangential dof 1
+    N = sp.csr_array([[1.0, 0.0]]); T = sp.csr_array([[0.0, 1.0]])
+    prob = fricont.Problem(A, N, T, friction=0.5)
+    path = prob.trace(f0=[1.0, 0.0], f1=[0.0, 1.0], window=(0.0, 2.0))
+    e = path.events[0]                          # stick -> slip+ at alpha = 0.5
+    print(e.alpha, e.node, e.from_class, e.to_class)
+
+Errors: invalid data raise ``ValueError`` with the library's message; numerical failures
+raise a subclass of :class:`fricont.Error` (``NotPositiveDefinite`` is also a
+``ValueError``).
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any, Callable, Optional, Sequence, Tuple
+
+import numpy as np
+import scipy.sparse as _sp
+
+from . import _core
+from ._core import (
+    Error,
+    LoadError,
+    NumericalError,
+    SolveError,
+    UsageError,
+)
+
+
+class NotPositiveDefinite(_core.NotPositiveDefinite, ValueError):
+    """A is not positive definite, or B = [N; T] is rank-deficient."""
+
+
+__all__ = [
+    "Problem",
+    "Path",
+    "Event",
+    "Piece",
+    "Solution",
+    "read_case",
+    "Error",
+    "NotPositiveDefinite",
+    "SolveError",
+    "LoadError",
+    "NumericalError",
+    "UsageError",
+    "__version__",
+]
+
+__version__ = _core.version()
+
+CLASSES = ("open", "stick", "slip+", "slip-")
+
+
+def _reraise(err: BaseException) -> BaseException:
+    """The library's NotPositiveDefinite as the Python-level class (also a ValueError)."""
+    if isinstance(err, _core.NotPositiveDefinite) and not isinstance(err, NotPositiveDefinite):
+        new = NotPositiveDefinite(*err.args)
+        new.__cause__ = None
+        return new
+    return err
+
+
+def _csr(name: str, m: Any, shape: Optional[Tuple[int, int]] = None):
+    """(shape, indptr int64, indices int64, data float64) of any scipy.sparse matrix or
+    array (CSR, CSC, COO, ...; int32 or int64 indices) or dense array-like."""
+    if _sp.issparse(m):
+        c = _sp.csr_array(m)
+    else:
+        d = np.asarray(m, dtype=np.float64)
+        if d.ndim != 2:
+            raise ValueError(f"{name}: expected a 2-D matrix, got an array of shape {d.shape}")
+        c = _sp.csr_array(d)
+    if c.has_canonical_format is False:
+        c = c.copy()
+        c.sum_duplicates()
+    return (
+        (int(c.shape[0]), int(c.shape[1])),
+        np.ascontiguousarray(c.indptr, dtype=np.int64),
+        np.ascontiguousarray(c.indices, dtype=np.int64),
+        np.ascontiguousarray(c.data, dtype=np.float64),
+    )
+
+
+def _vector(name: str, v: Any) -> np.ndarray:
+    a = np.ascontiguousarray(np.asarray(v, dtype=np.float64).ravel())
+    return a
+
+
+@dataclass(frozen=True)
+class Event:
+    """One node changing class at a transition point.
+
+    Attributes: ``alpha`` (the load parameter), ``node`` (0-based contact node),
+    ``from_class`` and ``to_class`` (``"open"``, ``"stick"``, ``"slip+"``, ``"slip-"``),
+    ``fold`` (alpha turns back here), ``bifurcation`` (more than one neighbouring piece
+    continues here), ``lambda_n`` and ``lambda_t`` (all p contact forces at the point,
+    force units, ``lambda_n <= 0`` compressive), ``transition`` (0-based transition point,
+    shared by the events of a degenerate transition), ``index`` (0-based position in
+    ``path.events``).
+    """
+
+    index: int
+    alpha: float
+    node: int
+    from_class: str
+    to_class: str
+    fold: bool
+    bifurcation: bool
+    lambda_n: np.ndarray
+    lambda_t: np.ndarray
+    transition: int
+
+
+@dataclass(frozen=True)
+class Piece:
+    """A traced smooth piece: the class of every node, the alpha range, the contact forces
+    at its ends (``lambda_from``, ``lambda_to``: 2p values, normal then tangential),
+    ``direction`` (sign of d alpha / ds, 0 for a vertical piece), the path's
+    ``orientation`` and ``det_sign`` (sign of det dH/d lambda)."""
+
+    alpha_from: float
+    alpha_to: float
+    classes: Tuple[str, ...]
+    direction: int
+    orientation: int
+    det_sign: int
+    lambda_from: np.ndarray
+    lambda_to: np.ndarray
+
+
+@dataclass(frozen=True)
+class Solution:
+    """A solution at a given alpha: ``piece`` (index in ``path.pieces``), the state
+    (``u``, ``lambda_n``, ``lambda_t``, ``classes``, ``residual``) and ``continuum`` (the
+    piece is vertical at this alpha: every point between its end forces is a solution)."""
+
+    piece: int
+    alpha: float
+    u: np.ndarray
+    lambda_n: np.ndarray
+    lambda_t: np.ndarray
+    classes: Tuple[str, ...]
+    residual: float
+    continuum: bool
+
+
+class Path:
+    """A traced path. Returned by :meth:`Problem.trace`; not created directly.
+
+    ``events``, ``pieces`` and ``end_reason`` describe what was traced; ``event_state(k)``
+    gives the full state at event k (one back-solve for u), ``solutions_at(alpha)`` every
+    traced solution at alpha, ``to_dict()`` the JSON report of the CLI (1-based numbers).
+    """
+
+    def __init__(self, core: Any):
+        self._core = core
+        self.events: list = [
+            Event(i, a, node, fc, tc, fold, bif, ln, lt, tr)
+            for i, (a, node, fc, tc, fold, bif, ln, lt, tr) in enumerate(core.events())
+        ]
+        self.pieces: list = [
+            Piece(
+                d["alpha_from"],
+                d["alpha_to"],
+                tuple(d["classes"]),
+                d["direction"],
+                d["orientation"],
+                d["det_sign"],
+                d["lambda_from"],
+                d["lambda_to"],
+            )
+            for d in core.pieces()
+        ]
+        reason, message = core.end_reason()
+        #: Why the path ended: "window", "max_steps", "closed_loop", "bifurcation",
+        #: "failed", or "stopped" (by the monitor).
+        self.end_reason: str = reason if reason is not None else "stopped"
+        #: The failure message when ``end_reason == "failed"``.
+        self.end_message: Optional[str] = message
+        self.start: Optional[dict] = core.start_state()
+
+    def __repr__(self) -> str:
+        return f"<fricont.Path: {len(self.events)} events, end {self.end_reason!r}>"
+
+    def event_state(self, k: int) -> dict:
+        """The full state at event k (0-based): ``u`` (n), ``lambda_n``, ``lambda_t`` (p),
+        ``classes`` (after the event), ``residual``, ``alpha``. One back-solve with the
+        Cholesky factor of A; the GIL is released meanwhile. Errors: IndexError-like
+        :class:`UsageError` for k out of range."""
+        try:
+            return self._core.event_state(int(k))
+        except Exception as err:  # noqa: BLE001
+            raise _reraise(err) from None
+
+    def solutions_at(self, alpha: float) -> list:
+        """Every traced solution at ``alpha`` (several past a fold), as :class:`Solution`
+        objects: one small solve on each stored piece whose alpha range contains it, plus a
+        back-solve for u."""
+        out = []
+        for piece, st, continuum in self._core.solutions_at(float(alpha)):
+            out.append(
+                Solution(
+                    piece,
+                    st["alpha"],
+                    st["u"],
+                    st["lambda_n"],
+                    st["lambda_t"],
+                    tuple(st["classes"]),
+                    st["residual"],
+                    continuum,
+                )
+            )
+        return out
+
+    def to_dict(self) -> dict:
+        """The path in the JSON shape of ``fricont trace --json`` (SPEC §8: nodes, events
+        and transition points counted from 1)."""
+        return json.loads(self._core.to_json())
+
+
+class Problem:
+    """A contact problem, factorised once (sparse Cholesky of A, Delassus operator
+    W = B A^-1 B^T with B = [N; T]); the GIL is released meanwhile.
+
+    Parameters
+    ----------
+    A : scipy.sparse matrix/array (CSR, CSC, COO, ...; int32 or int64 indices) or dense
+        array, n x n symmetric positive definite (Dirichlet dofs eliminated).
+    N, T : the same kinds, p x n: normal and tangential displacement of each contact node.
+    friction : float or length-p array, F >= 0.
+    gap : length-p array or None: initial normal gap g (N u <= g), default 0.
+    r : float or None: augmentation parameter (force per length), default 2p / trace(W).
+    storage : "full" (symmetry checked to 1e-10 relative), "lower" or "upper" (only that
+        triangle of A is read).
+
+    Raises ValueError (invalid data: dimensions, NaN/Inf, not symmetric, F < 0, r <= 0)
+    and NotPositiveDefinite (A not SPD, with the failing pivot; B rank-deficient).
+    """
+
+    def __init__(self, A, N, T, friction=0.3, gap=None, r=None, storage="full"):
+        a = _csr("A", A)
+        n = _csr("N", N)
+        t = _csr("T", T)
+        p = n[0][0]
+        fr = np.asarray(friction, dtype=np.float64).ravel()
+        if fr.size == 1:
+            fr_list = [float(fr[0])]
+        else:
+            fr_list = [float(x) for x in fr]
+            if len(fr_list) != p:
+                raise ValueError(f"friction has {len(fr_list)} values, expected 1 or p = {p}")
+        g = None if gap is None else [float(x) for x in np.asarray(gap, dtype=np.float64).ravel()]
+        try:
+            self._core = _core.Problem(a, n, t, fr_list, g, None if r is None else float(r), storage)
+        except Exception as err:  # noqa: BLE001
+            raise _reraise(err) from None
+
+    @property
+    def n(self) -> int:
+        """Number of dofs."""
+        return self._core.n
+
+    @property
+    def p(self) -> int:
+        """Number of contact nodes."""
+        return self._core.p
+
+    @property
+    def r(self) -> float:
+        """The augmentation parameter in use (force per length)."""
+        return self._core.r
+
+    def trace(
+        self,
+        f0=None,
+        f1=None,
+        window: Sequence[float] = (0.0, 1.0),
+        alpha_start: Optional[float] = None,
+        max_steps: Optional[int] = None,
+        *,
+        load: Optional[Callable[[float], Any]] = None,
+        dload: Optional[Callable[[float], Any]] = None,
+        n: Optional[int] = None,
+        monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None,
+    ) -> Path:
+        """Traces the solution path over ``window = (alpha_start, alpha_end)``.
+
+        Affine load: ``f(alpha) = f0 + alpha * f1`` (length-n arrays, force units).
+        General load: ``load(alpha)`` returns f (length n), ``dload(alpha)`` its derivative
+        (central differences when None); ``n`` defaults to the problem's n.
+
+        ``alpha_start`` (default ``window[0]``) is where the fixed-alpha solve starts the
+        path; it then goes toward ``window[1]``, through folds, until alpha leaves the
+        window. ``max_steps`` bounds the number of transition points (default 10 000).
+        ``monitor(alpha, transitions, (first_event, end_event))`` is called after each
+        transition point; a true return value stops the path (``end_reason == "stopped"``).
+
+        The GIL is released while tracing (re-acquired only to call ``load``, ``dload`` or
+        ``monitor``), so threads can trace different problems at once.
+
+        Raises: ValueError for bad arguments; SolveError when the start solve fails; an
+        exception raised inside ``load``/``dload``/``monitor`` stops the path and is
+        re-raised with what was traced kept on it as ``err.path`` (a :class:`Path`); other
+        numerical failures raise NumericalError, also with ``err.path``.
+        """
+        if len(window) != 2:
+            raise ValueError("window must be (alpha_start, alpha_end)")
+        win = (float(window[0]), float(window[1]))
+        a0 = None if alpha_start is None else float(alpha_start)
+        ms = None if max_steps is None else int(max_steps)
+        if load is not None:
+            if f0 is not None or f1 is not None:
+                raise ValueError("give either f0 and f1 (affine load) or load=, not both")
+            core = self._core.trace_general(
+                load, dload, int(n) if n is not None else self.n, win, a0, ms, monitor
+            )
+        else:
+            if f0 is None or f1 is None:
+                raise ValueError("an affine load needs f0 and f1 (or give load=)")
+            try:
+                core = self._core.trace_affine(
+                    _vector("f0", f0), _vector("f1", f1), win, a0, ms, monitor
+                )
+            except Exception as err:  # noqa: BLE001
+                raise _reraise(err) from None
+        err = core.take_error()
+        path = Path(core)
+        if err is not None:
+            err = _reraise(err)
+            try:
+                err.path = path
+            except AttributeError:
+                pass
+            raise err
+        return path
+
+
+def read_case(directory) -> dict:
+    """Reads a problem directory in the exchange format (``docs/exchange-format.md``):
+    returns a dict with ``A`` (scipy.sparse CSR array, full storage), ``N``, ``T`` (CSR,
+    p x n), ``f0``, ``f1`` (numpy, n), ``gap`` (numpy p, or None), ``friction`` (float or
+    numpy p), ``alpha_start``, ``alpha_end`` and ``meta`` (the whole meta.json as a dict).
+
+    Raises OSError naming the file and line for unreadable or malformed files, ValueError
+    when the files disagree (dimensions, NaN/Inf).
+    """
+    d = _core.read_case(str(directory))
+
+    def mat(t):
+        shape, indptr, indices, data = t
+        return _sp.csr_array((data, indices, indptr), shape=shape)
+
+    fr = d["friction"]
+    return {
+        "A": mat(d["A"]),
+        "N": mat(d["N"]),
+        "T": mat(d["T"]),
+        "f0": d["f0"],
+        "f1": d["f1"],
+        "gap": d["gap"],
+        "friction": float(fr[0]) if len(fr) == 1 else fr,
+        "alpha_start": d["alpha_start"],
+        "alpha_end": d["alpha_end"],
+        "meta": json.loads(d["meta"]),
+    }

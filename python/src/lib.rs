@@ -1,0 +1,522 @@
+//! `fricont._core`: the extension module behind the Python package `fricont`.
+//!
+//! The Python layer (`python/fricont/__init__.py`) converts scipy/numpy input to CSR
+//! arrays with int64 indices and wraps the results; this module only converts between
+//! numpy and the Rust API of `fricont`, releases the GIL while the library computes, and
+//! maps the library's errors to Python exceptions. Node indices are 0-based here.
+
+use std::sync::{Arc, Mutex};
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use fricont::load::LoadFailure;
+use fricont::path::State;
+use fricont::{
+    Class, CsrMatrix, EndReason, Load, PathOptions, ProblemBuilder, StepOutcome, Storage,
+};
+use fricont_exchange::io::CaseData;
+use fricont_exchange::report::{PathReport, Timing};
+
+create_exception!(_core, Error, PyException, "A numerical failure of fricont.");
+create_exception!(
+    _core,
+    NotPositiveDefinite,
+    Error,
+    "A is not positive definite, or B = [N; T] is rank-deficient (W not positive definite)."
+);
+create_exception!(
+    _core,
+    SolveError,
+    Error,
+    "The fixed-alpha solve (the start point) did not converge."
+);
+create_exception!(
+    _core,
+    LoadError,
+    Error,
+    "The load callable failed or returned non-finite values."
+);
+create_exception!(
+    _core,
+    NumericalError,
+    Error,
+    "A numerical failure while tracing."
+);
+create_exception!(
+    _core,
+    UsageError,
+    Error,
+    "A call made in the wrong order (e.g. choosing a branch where there is none)."
+);
+
+/// Maps a library error to the documented Python exception.
+fn to_py(e: fricont::Error) -> PyErr {
+    use fricont::Error as E;
+    let msg = e.to_string();
+    match e {
+        E::Dimension(_) | E::Csr(_) | E::NonFinite(_) | E::NotSymmetric(_) => {
+            PyValueError::new_err(msg)
+        }
+        E::InvalidParameter(_) => PyValueError::new_err(msg),
+        E::NotSpd { .. } | E::RankDeficient(_) => NotPositiveDefinite::new_err(msg),
+        E::Load { .. } => LoadError::new_err(msg),
+        E::SolveFailed { .. } => SolveError::new_err(msg),
+        E::Usage(_) => UsageError::new_err(msg),
+        _ => NumericalError::new_err(msg),
+    }
+}
+
+fn exchange_err(e: fricont_exchange::Error) -> PyErr {
+    match e {
+        fricont_exchange::Error::Core(c) => to_py(c),
+        fricont_exchange::Error::Io(m) => pyo3::exceptions::PyOSError::new_err(m),
+    }
+}
+
+/// A CSR matrix from (indptr, indices, data) with int64 indices, 0-based.
+fn csr(
+    name: &str,
+    shape: (usize, usize),
+    indptr: PyReadonlyArray1<'_, i64>,
+    indices: PyReadonlyArray1<'_, i64>,
+    data: PyReadonlyArray1<'_, f64>,
+) -> PyResult<CsrMatrix> {
+    CsrMatrix::from_raw(
+        name,
+        shape.0,
+        shape.1,
+        indptr.as_slice()?,
+        indices.as_slice()?,
+        data.as_slice()?,
+        0,
+    )
+    .map_err(to_py)
+}
+
+fn class_name(c: Class) -> &'static str {
+    c.name()
+}
+
+fn classes_list(c: &[Class]) -> Vec<&'static str> {
+    c.iter().map(|&c| class_name(c)).collect()
+}
+
+fn state_dict<'py>(py: Python<'py>, s: &State, with_u: bool) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("alpha", s.alpha)?;
+    if with_u {
+        d.set_item("u", s.u.clone().into_pyarray(py))?;
+    }
+    d.set_item("lambda_n", s.lambda_n.clone().into_pyarray(py))?;
+    d.set_item("lambda_t", s.lambda_t.clone().into_pyarray(py))?;
+    d.set_item("classes", classes_list(&s.classes))?;
+    d.set_item("residual", s.residual)?;
+    Ok(d)
+}
+
+/// A problem: A, N, T, friction, gap, r, factorised once (Cholesky of A, W = B A⁻¹ Bᵀ).
+#[pyclass(module = "fricont._core", frozen)]
+struct Problem {
+    inner: Arc<fricont::Problem>,
+}
+
+/// Arguments of one CSR matrix as the Python layer passes them.
+type CsrArgs<'py> = (
+    (usize, usize),
+    PyReadonlyArray1<'py, i64>,
+    PyReadonlyArray1<'py, i64>,
+    PyReadonlyArray1<'py, f64>,
+);
+
+#[pymethods]
+impl Problem {
+    /// Builds the problem (validation, Cholesky of A, Delassus operator) with the GIL
+    /// released. `storage`: "full", "lower" or "upper". Errors: ValueError for invalid
+    /// data, NotPositiveDefinite when A is not SPD or B is rank-deficient.
+    #[new]
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (a, n, t, friction, gap, r, storage))]
+    fn new(
+        py: Python<'_>,
+        a: CsrArgs<'_>,
+        n: CsrArgs<'_>,
+        t: CsrArgs<'_>,
+        friction: Vec<f64>,
+        gap: Option<Vec<f64>>,
+        r: Option<f64>,
+        storage: &str,
+    ) -> PyResult<Self> {
+        let storage = match storage {
+            "full" => Storage::Full,
+            "lower" => Storage::Lower,
+            "upper" => Storage::Upper,
+            s => {
+                return Err(PyValueError::new_err(format!(
+                    "storage = {s:?}: expected \"full\", \"lower\" or \"upper\""
+                )));
+            }
+        };
+        let a = csr("A", a.0, a.1, a.2, a.3)?;
+        let nm = csr("N", n.0, n.1, n.2, n.3)?;
+        let tm = csr("T", t.0, t.1, t.2, t.3)?;
+        let mut b = ProblemBuilder::new(a, storage, nm, tm);
+        b = if friction.len() == 1 {
+            b.friction_uniform(friction[0])
+        } else {
+            b.friction(friction)
+        };
+        if let Some(g) = gap {
+            b = b.gap(g);
+        }
+        if let Some(r) = r {
+            b = b.r(r);
+        }
+        let inner = py.detach(move || b.build()).map_err(to_py)?;
+        Ok(Problem {
+            inner: Arc::new(inner),
+        })
+    }
+
+    /// Number of dofs.
+    #[getter]
+    fn n(&self) -> usize {
+        self.inner.n()
+    }
+
+    /// Number of contact nodes.
+    #[getter]
+    fn p(&self) -> usize {
+        self.inner.p()
+    }
+
+    /// The augmentation parameter r in use (force per length).
+    #[getter]
+    fn r(&self) -> f64 {
+        self.inner.r()
+    }
+
+    /// Friction coefficients (p).
+    #[getter]
+    fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.friction().to_vec().into_pyarray(py)
+    }
+
+    /// Traces an affine load f0 + α f1 (see `fricont.Problem.trace`).
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (f0, f1, window, alpha_start, max_steps, monitor))]
+    fn trace_affine(
+        &self,
+        py: Python<'_>,
+        f0: PyReadonlyArray1<'_, f64>,
+        f1: PyReadonlyArray1<'_, f64>,
+        window: (f64, f64),
+        alpha_start: Option<f64>,
+        max_steps: Option<usize>,
+        monitor: Option<Py<PyAny>>,
+    ) -> PyResult<Path> {
+        let load = Load::affine(f0.as_slice()?.to_vec(), f1.as_slice()?.to_vec()).map_err(to_py)?;
+        self.trace(py, load, window, alpha_start, max_steps, monitor, None)
+    }
+
+    /// Traces a general load: `load(alpha)` returns f (n values); `dload(alpha)` its
+    /// derivative (central differences when None). An exception inside either stops the
+    /// path; it is kept on the path and re-raised by the Python layer.
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (load, dload, n, window, alpha_start, max_steps, monitor))]
+    fn trace_general(
+        &self,
+        py: Python<'_>,
+        load: Py<PyAny>,
+        dload: Option<Py<PyAny>>,
+        n: usize,
+        window: (f64, f64),
+        alpha_start: Option<f64>,
+        max_steps: Option<usize>,
+        monitor: Option<Py<PyAny>>,
+    ) -> PyResult<Path> {
+        let slot: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
+        let wrap = |callable: Py<PyAny>, what: &'static str| {
+            let slot = slot.clone();
+            Box::new(move |alpha: f64, out: &mut [f64]| {
+                Python::attach(|py| -> Result<(), LoadFailure> {
+                    let fail = |e: PyErr| {
+                        let message = format!("{what} raised {e}");
+                        if let Ok(mut s) = slot.lock() {
+                            s.get_or_insert(e);
+                        }
+                        LoadFailure { code: 1, message }
+                    };
+                    let v = callable.call1(py, (alpha,)).map_err(fail)?;
+                    let np = py.import("numpy").map_err(fail)?;
+                    let arr = np
+                        .call_method1("ascontiguousarray", (v, "float64"))
+                        .map_err(fail)?;
+                    let arr: PyReadonlyArray1<'_, f64> = arr.extract().map_err(|e: PyErr| {
+                        fail(PyValueError::new_err(format!(
+                            "{what} must return a 1-D array of n floats: {e}"
+                        )))
+                    })?;
+                    let s = arr.as_slice().map_err(|e| fail(e.into()))?;
+                    if s.len() != out.len() {
+                        return Err(fail(PyValueError::new_err(format!(
+                            "{what} returned {} values, expected n = {}",
+                            s.len(),
+                            out.len()
+                        ))));
+                    }
+                    out.copy_from_slice(s);
+                    Ok(())
+                })
+            }) as fricont::load::VectorFn
+        };
+        let f = wrap(load, "load");
+        let df = dload.map(|d| wrap(d, "dload"));
+        let load = Load::general(n, f, df);
+        self.trace(
+            py,
+            load,
+            window,
+            alpha_start,
+            max_steps,
+            monitor,
+            Some(slot),
+        )
+    }
+}
+
+impl Problem {
+    #[allow(clippy::too_many_arguments)]
+    fn trace(
+        &self,
+        py: Python<'_>,
+        load: Load,
+        window: (f64, f64),
+        alpha_start: Option<f64>,
+        max_steps: Option<usize>,
+        monitor: Option<Py<PyAny>>,
+        slot: Option<Arc<Mutex<Option<PyErr>>>>,
+    ) -> PyResult<Path> {
+        let mut opts = PathOptions::window(window.0, window.1);
+        if let Some(a) = alpha_start {
+            opts.alpha_start = a;
+        }
+        if let Some(k) = max_steps {
+            if k == 0 {
+                return Err(PyValueError::new_err("max_steps must be at least 1"));
+            }
+            opts.max_steps = k;
+        }
+        let start = opts.alpha_start;
+        let problem = self.inner.clone();
+        let t0 = std::time::Instant::now();
+        let mut path = fricont::Path::new(problem, load, opts).map_err(to_py)?;
+        let setup_s = t0.elapsed().as_secs_f64();
+        let t1 = std::time::Instant::now();
+        // Trace with the GIL released; the monitor and a Python load re-attach.
+        let outcome: Result<(), PyErr> = py.detach(|| {
+            path.start(start, None).map_err(to_py)?;
+            loop {
+                match path.step().map_err(to_py)? {
+                    StepOutcome::End(_) => return Ok(()),
+                    StepOutcome::Transition { events, .. } => {
+                        if let Some(m) = &monitor {
+                            let a = path.events()[events.start].alpha;
+                            let k = path.events()[events.end - 1].transition + 1;
+                            let stop = Python::attach(|py| -> PyResult<bool> {
+                                m.call1(py, (a, k, (events.start, events.end)))?
+                                    .bind(py)
+                                    .is_truthy()
+                            })?;
+                            if stop {
+                                return Ok(());
+                            }
+                        }
+                    }
+                }
+            }
+        });
+        let trace_s = t1.elapsed().as_secs_f64();
+        let callback_error = slot.and_then(|s| s.lock().ok().and_then(|mut g| g.take()));
+        let error = match (outcome, callback_error) {
+            (Err(_), Some(e)) => Some(e),
+            (Err(e), None) => Some(e),
+            (Ok(()), _) => None,
+        };
+        Ok(Path {
+            inner: Mutex::new(path),
+            error: Mutex::new(error),
+            timing: Timing { setup_s, trace_s },
+        })
+    }
+}
+
+/// A traced path (see `fricont.Path`).
+#[pyclass(module = "fricont._core", frozen)]
+struct Path {
+    inner: Mutex<fricont::Path>,
+    error: Mutex<Option<PyErr>>,
+    timing: Timing,
+}
+
+impl Path {
+    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, fricont::Path>> {
+        self.inner
+            .lock()
+            .map_err(|_| UsageError::new_err("the path is poisoned by an earlier panic"))
+    }
+}
+
+#[pymethods]
+impl Path {
+    /// The exception that stopped tracing, if any (taken: a second call gives None).
+    fn take_error(&self) -> Option<PyErr> {
+        self.error.lock().ok().and_then(|mut e| e.take())
+    }
+
+    /// Events as tuples (alpha, node, from, to, fold, bifurcation, lambda_n, lambda_t,
+    /// transition), node and transition 0-based.
+    fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let path = self.lock()?;
+        let out = PyList::empty(py);
+        for e in path.events() {
+            out.append((
+                e.alpha,
+                e.node,
+                class_name(e.from),
+                class_name(e.to),
+                e.fold,
+                e.bifurcation,
+                e.lambda_n.clone().into_pyarray(py),
+                e.lambda_t.clone().into_pyarray(py),
+                e.transition,
+            ))?;
+        }
+        Ok(out)
+    }
+
+    /// Pieces as dicts (alpha_from, alpha_to, classes, direction, orientation, det_sign,
+    /// lambda_from, lambda_to).
+    fn pieces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let path = self.lock()?;
+        let out = PyList::empty(py);
+        for r in path.pieces() {
+            let d = PyDict::new(py);
+            d.set_item("alpha_from", r.alpha_from)?;
+            d.set_item("alpha_to", r.alpha_to)?;
+            d.set_item("classes", classes_list(&r.classes))?;
+            d.set_item("direction", r.direction)?;
+            d.set_item("orientation", r.orientation)?;
+            d.set_item("det_sign", r.det_sign)?;
+            d.set_item("lambda_from", r.lambda_from.clone().into_pyarray(py))?;
+            d.set_item("lambda_to", r.lambda_to.clone().into_pyarray(py))?;
+            out.append(d)?;
+        }
+        Ok(out)
+    }
+
+    /// Why the path ended ("window", "max_steps", "closed_loop", "bifurcation", "failed")
+    /// and the failure message, or (None, None) while it could go on (stopped by a
+    /// monitor).
+    fn end_reason(&self) -> PyResult<(Option<&'static str>, Option<String>)> {
+        let path = self.lock()?;
+        Ok(match path.end_reason() {
+            Some(EndReason::Failed(m)) => (Some("failed"), Some(m.clone())),
+            Some(r) => (Some(r.name()), None),
+            None => (None, None),
+        })
+    }
+
+    /// The start state (alpha, lambda_n, lambda_t, classes, residual; no u).
+    fn start_state<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let path = self.lock()?;
+        path.start_state()
+            .map(|s| state_dict(py, s, false))
+            .transpose()
+    }
+
+    /// The full state at event k (0-based): u by one back-solve, with the GIL released.
+    fn event_state<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyDict>> {
+        let st = py.detach(|| -> PyResult<State> { self.lock()?.event_state(k).map_err(to_py) })?;
+        state_dict(py, &st, true)
+    }
+
+    /// Every traced solution at alpha: list of (piece, state dict, continuum).
+    fn solutions_at<'py>(&self, py: Python<'py>, alpha: f64) -> PyResult<Bound<'py, PyList>> {
+        let sols = py.detach(|| -> PyResult<Vec<fricont::Solution>> {
+            self.lock()?.solutions_at(alpha).map_err(to_py)
+        })?;
+        let out = PyList::empty(py);
+        for s in &sols {
+            out.append((s.piece, state_dict(py, &s.state, true)?, s.continuum))?;
+        }
+        Ok(out)
+    }
+
+    /// The JSON report of the CLI (SPEC §8), as text.
+    fn to_json(&self) -> PyResult<String> {
+        let mut path = self.lock()?;
+        Ok(PathReport::from_path(&mut path, self.timing).to_json_string())
+    }
+}
+
+/// Reads a problem directory in the exchange format: a dict with the CSR arrays of A
+/// (full storage), N, T, the vectors f0, f1, gap (or None), friction, the window and the
+/// metadata as JSON text. Errors: OSError naming the file and line; ValueError when the
+/// files disagree.
+#[pyfunction]
+fn read_case<'py>(py: Python<'py>, directory: std::path::PathBuf) -> PyResult<Bound<'py, PyDict>> {
+    let case = py
+        .detach(|| CaseData::read_dir(&directory))
+        .map_err(exchange_err)?;
+    let d = PyDict::new(py);
+    let put_csr = |name: &str, m: &CsrMatrix| -> PyResult<()> {
+        let rp: Vec<i64> = m.row_ptr().iter().map(|&x| x as i64).collect();
+        let ci: Vec<i64> = m.col_idx().iter().map(|&x| x as i64).collect();
+        d.set_item(
+            name,
+            (
+                (m.nrows(), m.ncols()),
+                rp.into_pyarray(py),
+                ci.into_pyarray(py),
+                m.values().to_vec().into_pyarray(py),
+            ),
+        )
+    };
+    put_csr("A", &case.a)?;
+    put_csr("N", &case.n_mat)?;
+    put_csr("T", &case.t_mat)?;
+    d.set_item("f0", case.f0.clone().into_pyarray(py))?;
+    d.set_item("f1", case.f1.clone().into_pyarray(py))?;
+    d.set_item("gap", case.gap.clone().map(|g| g.into_pyarray(py)))?;
+    d.set_item("friction", case.friction.clone().into_pyarray(py))?;
+    d.set_item("alpha_start", case.alpha_start)?;
+    d.set_item("alpha_end", case.alpha_end)?;
+    d.set_item("meta", case.meta.to_string())?;
+    Ok(d)
+}
+
+/// The library version.
+#[pyfunction]
+fn version() -> &'static str {
+    env!("CARGO_PKG_VERSION")
+}
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_class::<Problem>()?;
+    m.add_class::<Path>()?;
+    m.add_function(wrap_pyfunction!(read_case, m)?)?;
+    m.add_function(wrap_pyfunction!(version, m)?)?;
+    m.add("Error", py.get_type::<Error>())?;
+    m.add("NotPositiveDefinite", py.get_type::<NotPositiveDefinite>())?;
+    m.add("SolveError", py.get_type::<SolveError>())?;
+    m.add("LoadError", py.get_type::<LoadError>())?;
+    m.add("NumericalError", py.get_type::<NumericalError>())?;
+    m.add("UsageError", py.get_type::<UsageError>())?;
+    Ok(())
+}
