@@ -8,23 +8,39 @@
 //! ```
 //!
 //! [`Delassus`] holds one fill-reducing sparse Cholesky factor of `A` (faer, sequential so
-//! that it never touches a host program's thread pool) and the dense `W`, formed by one
-//! multi-right-hand-side solve in blocks of columns.
+//! that it never touches a host program's thread pool) and the dense `W`.
+//!
+//! **W by the trailing block** (SPEC §6). B touches only the s dofs of the contact nodes
+//! (the union S of the column supports of N and T). They are ordered *last* (after an AMD
+//! ordering of the others, then among themselves in AMD order), so that with
+//! `P A Pᵀ = L Lᵀ` the trailing s × s block `L_SS` of the factor gives
+//! `(A⁻¹)_SS = (L_SS L_SSᵀ)⁻¹` and `W = Zᵀ Z` with `Z = L_SS⁻¹ B_Sᵀ`: one dense triangular
+//! solve of size s with 2p columns instead of 2p sparse solves with A. It is used when
+//! `s ≤ TRAILING_MAX_RATIO · 2p` (nodal contact has s ≤ 2p); wider rows (mortar-type B)
+//! fall back to the solves, one multi-right-hand-side solve in blocks of columns. Both
+//! give the same W up to rounding ([`Delassus::w_by_solves`] recomputes it the second way).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError as DenseLltError;
+use faer::perm::PermRef;
+use faer::sparse::linalg::cholesky::supernodal::SupernodalLltRef;
 use faer::sparse::linalg::cholesky::{
-    LltRef, SymbolicCholesky, SymbolicCholeskyRaw, factorize_symbolic_cholesky,
+    LltRef, SymbolicCholesky, SymbolicCholeskyRaw, SymmetricOrdering, factorize_symbolic_cholesky,
 };
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, Mat, MatMut, MatRef, Par, Side};
+use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
 use crate::error::{Error, Result};
 use crate::problem::CsrMatrix;
 
-/// Columns of `Bᵀ` solved at once when forming `W` (bounds the dense workspace to
-/// `n × BLOCK` numbers).
+/// Columns of `Bᵀ` solved at once when forming `W` by solves (bounds the dense workspace
+/// to `n × BLOCK` numbers).
 const BLOCK: usize = 32;
+
+/// W is formed from the trailing block of the factor when the number s of dofs that B
+/// touches is at most this multiple of 2p (the dense `L_SS` then holds at most
+/// `(2 · 2p)²` numbers); otherwise by 2p solves.
+pub const TRAILING_MAX_RATIO: usize = 2;
 
 /// The Cholesky factor of `A` and the Delassus operator `W = B A⁻¹ Bᵀ`.
 #[derive(Debug)]
@@ -34,6 +50,7 @@ pub struct Delassus {
     l_values: Vec<f64>,
     b: CsrMatrix,
     w: Mat<f64>,
+    trailing: bool,
 }
 
 impl Delassus {
@@ -58,8 +75,34 @@ impl Delassus {
                 faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
-        let symbolic = factorize_symbolic_cholesky(symb, Side::Upper, Default::default(), params)
-            .map_err(|e| Error::Numerical(format!("symbolic Cholesky of A: {e:?}")))?;
+        let symbolic_err = |e| Error::Numerical(format!("symbolic Cholesky of A: {e:?}"));
+        let amd = factorize_symbolic_cholesky(symb, Side::Upper, SymmetricOrdering::Amd, params)
+            .map_err(symbolic_err)?;
+        // The dofs B touches, and whether W comes from the trailing block of the factor.
+        let mut touched = vec![false; n];
+        for &j in b.col_idx() {
+            touched[j] = true;
+        }
+        let s = touched.iter().filter(|&&t| t).count();
+        let trailing = s > 0 && s <= TRAILING_MAX_RATIO * b.nrows().max(1);
+        let symbolic = if trailing {
+            // AMD order of the others, then the touched dofs (in AMD order) last.
+            let amd_fwd: Vec<usize> = match amd.perm() {
+                Some(p) => p.arrays().0.to_vec(),
+                None => (0..n).collect(),
+            };
+            let mut fwd: Vec<usize> = amd_fwd.iter().copied().filter(|&j| !touched[j]).collect();
+            fwd.extend(amd_fwd.iter().copied().filter(|&j| touched[j]));
+            let mut inv = vec![0usize; n];
+            for (k, &j) in fwd.iter().enumerate() {
+                inv[j] = k;
+            }
+            let perm = PermRef::new_checked(&fwd, &inv, n);
+            factorize_symbolic_cholesky(symb, Side::Upper, SymmetricOrdering::Custom(perm), params)
+                .map_err(symbolic_err)?
+        } else {
+            amd
+        };
         let mut l_values = vec![0.0f64; symbolic.len_val()];
         let par = Par::Seq;
         {
@@ -98,13 +141,83 @@ impl Delassus {
             l_values,
             b: b.clone(),
             w: Mat::zeros(0, 0),
+            trailing: false,
         };
-        this.w = this.form_w()?;
+        this.w = match trailing.then(|| this.w_by_trailing_block(s)).flatten() {
+            Some(w) => {
+                this.trailing = true;
+                w
+            }
+            None => this.w_by_solves(),
+        };
         this.check_w()?;
         Ok(this)
     }
 
-    fn form_w(&self) -> Result<Mat<f64>> {
+    /// `W = Zᵀ Z`, `Z = L_SS⁻¹ B_Sᵀ`, from the trailing s × s block of a supernodal factor
+    /// whose ordering puts the s dofs that B touches last. None when the factor does not
+    /// have that form (then W is formed by solves).
+    fn w_by_trailing_block(&self, s: usize) -> Option<Mat<f64>> {
+        let n = self.n;
+        let m = self.b.nrows();
+        let SymbolicCholeskyRaw::Supernodal(sym) = self.symbolic.raw() else {
+            return None;
+        };
+        let inv = self.symbolic.perm()?.arrays().1;
+        let first = n - s;
+        // Every dof B touches must sit in the trailing block.
+        if self.b.col_idx().iter().any(|&j| inv[j] < first) {
+            return None;
+        }
+        let llt = SupernodalLltRef::<'_, usize, f64>::new(sym, &self.l_values);
+        let mut lss = Mat::<f64>::zeros(s, s);
+        for k in 0..sym.n_supernodes() {
+            let node = llt.supernode(k);
+            let start = node.start();
+            let val = node.val();
+            let ncols = val.ncols();
+            if start + ncols <= first {
+                continue;
+            }
+            let pattern = node.pattern();
+            for c in start.max(first)..start + ncols {
+                let cl = c - start;
+                for r in c..start + ncols {
+                    lss[(r - first, c - first)] = val[(r - start, cl)];
+                }
+                for (t, &r) in pattern.iter().enumerate() {
+                    lss[(r - first, c - first)] = val[(ncols + t, cl)];
+                }
+            }
+        }
+        let mut z = Mat::<f64>::zeros(s, m);
+        for i in 0..m {
+            for (j, v) in self.b.row(i) {
+                z[(inv[j] - first, i)] = v;
+            }
+        }
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(
+            lss.as_ref(),
+            z.as_mut(),
+            Par::Seq,
+        );
+        let mut w = Mat::<f64>::zeros(m, m);
+        faer::linalg::matmul::matmul(
+            w.as_mut(),
+            Accum::Replace,
+            z.transpose(),
+            z.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        symmetrise(&mut w);
+        Some(w)
+    }
+
+    /// `W = B A⁻¹ Bᵀ` by 2p solves with the factor of A, in blocks of columns: how W is
+    /// formed when B's rows are wide, and an independent check of the trailing-block W
+    /// (the two agree to rounding: ~1e-13 relative).
+    pub fn w_by_solves(&self) -> Mat<f64> {
         let m = self.b.nrows();
         let mut w = Mat::<f64>::zeros(m, m);
         let mut x = Mat::<f64>::zeros(self.n, BLOCK.min(m));
@@ -126,15 +239,8 @@ impl Delassus {
             }
             col0 += k;
         }
-        // symmetrise the rounding
-        for i in 0..m {
-            for j in 0..i {
-                let s = 0.5 * (w[(i, j)] + w[(j, i)]);
-                w[(i, j)] = s;
-                w[(j, i)] = s;
-            }
-        }
-        Ok(w)
+        symmetrise(&mut w);
+        w
     }
 
     fn check_w(&self) -> Result<()> {
@@ -189,6 +295,12 @@ impl Delassus {
         self.w.as_ref()
     }
 
+    /// True when W was formed from the trailing block of the factor (the dofs that B
+    /// touches ordered last), false when by 2p solves (wide rows of B).
+    pub fn w_from_trailing_block(&self) -> bool {
+        self.trailing
+    }
+
     /// `B = [N; T]`.
     pub fn b(&self) -> &CsrMatrix {
         &self.b
@@ -236,5 +348,16 @@ impl Delassus {
         self.b.mul_t_vec_add(lambda, &mut x);
         self.solve_in_place(&mut x);
         x
+    }
+}
+
+/// Replaces `w` by `(w + wᵀ) / 2` (the rounding of a product is not symmetric).
+fn symmetrise(w: &mut Mat<f64>) {
+    for i in 0..w.nrows() {
+        for j in 0..i {
+            let s = 0.5 * (w[(i, j)] + w[(j, i)]);
+            w[(i, j)] = s;
+            w[(j, i)] = s;
+        }
     }
 }

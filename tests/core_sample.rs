@@ -227,6 +227,54 @@ fn sample_rect30_transition_points_precise() {
         );
         want.push((exit, e.node, e.from, e.to));
     }
+    // How precisely the data determine each event: the events of the same problem with
+    // every entry of A changed by a few units in the last place (a symmetric, sign-mixed
+    // relative perturbation of 4ε). No computation in f64 can locate an event more
+    // precisely than that; well-conditioned events move by ~1e-15, the sample's shallow
+    // crossing (event 3) by ~1e-12.
+    let eps4 = 4.0 * f64::EPSILON;
+    let perturbed: Vec<(usize, usize, f64)> = read_mtx(&dir.join("A.mtx"))
+        .2
+        .into_iter()
+        .map(|(i, j, v)| {
+            let (lo, hi) = (i.min(j), i.max(j));
+            let sign = if (lo * 7919 + hi * 104_729) % 3 == 0 {
+                -1.0
+            } else {
+                1.0
+            };
+            (i, j, v * (1.0 + sign * eps4))
+        })
+        .collect();
+    let csr = |f: &str| {
+        let (r, c, t) = read_mtx(&dir.join(f));
+        CsrMatrix::from_triplets(f, r, c, &t).unwrap()
+    };
+    let pert = ProblemBuilder::new(
+        CsrMatrix::from_triplets("A", data.n, data.n, &perturbed).unwrap(),
+        Storage::Full,
+        csr("N.mtx"),
+        csr("T.mtx"),
+    )
+    .friction(data.friction.clone())
+    .gap(data.gap.clone())
+    .build()
+    .unwrap();
+    let pert_path = trace(Arc::new(pert), data.affine_load(), s.a0, s.a1);
+    assert_eq!(pert_path.events().len(), reference.events().len());
+    let sensitivity: Vec<f64> = pert_path
+        .events()
+        .iter()
+        .zip(reference.events())
+        .map(|(x, y)| (x.alpha - y.alpha).abs())
+        .collect();
+    eprintln!(
+        "sensitivity of the events to a 4-ulp perturbation of A: {:?}",
+        sensitivity
+            .iter()
+            .map(|x| format!("{x:.1e}"))
+            .collect::<Vec<_>>()
+    );
     let mut failures = Vec::new();
     let mut runs = Vec::new();
     for f in [1e-3, 1.0, 1e3] {
@@ -242,7 +290,10 @@ fn sample_rect30_transition_points_precise() {
                 e.state.residual
             );
             let rel = (e.alpha - x) / x.abs().max(1.0);
-            if rel.abs() > 1e-12 {
+            // 1e-12 relative, widened by what the data determine (the sensitivity above,
+            // with a factor 4 for the rounding of the factorisation, which exceeds 4 ulp).
+            let tol = 1e-12 + 4.0 * sensitivity[e.index] / x.abs().max(1.0);
+            if rel.abs() > tol {
                 failures.push(format!(
                     "r = {f:e}·r0: event {} (node {}, {} -> {}) α = {:.17e}, reference {:.17e}, relative error {rel:.1e}",
                     e.index + 1,
