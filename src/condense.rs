@@ -42,6 +42,20 @@ const BLOCK: usize = 32;
 /// `(2 · 2p)²` numbers); otherwise by 2p solves.
 pub const TRAILING_MAX_RATIO: usize = 2;
 
+/// Wall-clock times of the set-up phases, in seconds, and the size of the factor.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SetupTimes {
+    /// Symbolic analysis: the fill-reducing ordering (with the contact dofs last when W
+    /// comes from the trailing block) and the structure of the factor.
+    pub analyse_s: f64,
+    /// Numeric Cholesky factorisation of A.
+    pub factorise_s: f64,
+    /// Forming W (trailing block or solves) and checking that it is positive definite.
+    pub w_s: f64,
+    /// Number of stored values of the factor L.
+    pub nnz_l: usize,
+}
+
 /// The Cholesky factor of `A` and the Delassus operator `W = B A⁻¹ Bᵀ`.
 #[derive(Debug)]
 pub struct Delassus {
@@ -51,6 +65,7 @@ pub struct Delassus {
     b: CsrMatrix,
     w: Mat<f64>,
     trailing: bool,
+    times: SetupTimes,
 }
 
 impl Delassus {
@@ -75,6 +90,7 @@ impl Delassus {
                 faer::sparse::linalg::SupernodalThreshold::FORCE_SUPERNODAL,
             ..Default::default()
         };
+        let t_analyse = std::time::Instant::now();
         let symbolic_err = |e| Error::Numerical(format!("symbolic Cholesky of A: {e:?}"));
         let amd = factorize_symbolic_cholesky(symb, Side::Upper, SymmetricOrdering::Amd, params)
             .map_err(symbolic_err)?;
@@ -103,6 +119,8 @@ impl Delassus {
         } else {
             amd
         };
+        let analyse_s = t_analyse.elapsed().as_secs_f64();
+        let t_factorise = std::time::Instant::now();
         let mut l_values = vec![0.0f64; symbolic.len_val()];
         let par = Par::Seq;
         {
@@ -142,7 +160,12 @@ impl Delassus {
             b: b.clone(),
             w: Mat::zeros(0, 0),
             trailing: false,
+            times: SetupTimes::default(),
         };
+        this.times.analyse_s = analyse_s;
+        this.times.factorise_s = t_factorise.elapsed().as_secs_f64();
+        this.times.nnz_l = this.l_values.len();
+        let t_w = std::time::Instant::now();
         this.w = match trailing.then(|| this.w_by_trailing_block(s)).flatten() {
             Some(w) => {
                 this.trailing = true;
@@ -151,6 +174,7 @@ impl Delassus {
             None => this.w_by_solves(),
         };
         this.check_w()?;
+        this.times.w_s = t_w.elapsed().as_secs_f64();
         Ok(this)
     }
 
@@ -253,33 +277,32 @@ impl Delassus {
                 format!("row {} of T (node {})", i - p + 1, i - p + 1)
             }
         };
-        // Plain Cholesky with a relative pivot test: pivot² ≤ 1e-12 W_ii means the row of
-        // B is (numerically) a combination of the previous ones.
-        let mut l = self.w.clone();
+        // Cholesky of W (faer, blocked) with a relative pivot test: a pivot d_j = L_jj²
+        // ≤ 1e-12 W_jj means that row j of B is (numerically) a combination of the rows
+        // before it.
         for j in 0..m {
-            let wjj = self.w[(j, j)];
-            if wjj <= 0.0 {
+            if self.w[(j, j)] <= 0.0 {
                 return Err(Error::RankDeficient(format!("{} is zero", name(j))));
             }
-            let mut d = l[(j, j)];
-            for k in 0..j {
-                d -= l[(j, k)] * l[(j, k)];
+        }
+        let dependent = |j: usize, d: f64| {
+            Error::RankDeficient(format!(
+                "{} depends linearly on the rows before it (relative pivot {:e})",
+                name(j),
+                d / self.w[(j, j)]
+            ))
+        };
+        let llt = match self.w.llt(Side::Lower) {
+            Ok(llt) => llt,
+            Err(DenseLltError::NonPositivePivot { index }) => {
+                return Err(dependent(index.min(m.saturating_sub(1)), 0.0));
             }
-            if d <= 1e-12 * wjj {
-                return Err(Error::RankDeficient(format!(
-                    "{} depends linearly on the rows before it (relative pivot {:e})",
-                    name(j),
-                    d / wjj
-                )));
-            }
-            let djj = d.sqrt();
-            l[(j, j)] = djj;
-            for i in j + 1..m {
-                let mut s = l[(i, j)];
-                for k in 0..j {
-                    s -= l[(i, k)] * l[(j, k)];
-                }
-                l[(i, j)] = s / djj;
+        };
+        let l = llt.L();
+        for j in 0..m {
+            let d = l[(j, j)] * l[(j, j)];
+            if d <= 1e-12 * self.w[(j, j)] {
+                return Err(dependent(j, d));
             }
         }
         Ok(())
@@ -293,6 +316,11 @@ impl Delassus {
     /// `W = B A⁻¹ Bᵀ` (2p×2p; rows/cols `0..p` normal, `p..2p` tangential).
     pub fn w(&self) -> MatRef<'_, f64> {
         self.w.as_ref()
+    }
+
+    /// Times of the set-up phases and nnz(L) (see [`SetupTimes`]).
+    pub fn setup_times(&self) -> SetupTimes {
+        self.times
     }
 
     /// True when W was formed from the trailing block of the factor (the dofs that B
