@@ -156,6 +156,8 @@ pub(crate) struct BoundLoad {
     q_basis: Vec<Vec<f64>>,
     weights: Vec<f64>,
     dweights: Vec<f64>,
+    /// α of `weights` (NaN before the first evaluation).
+    weights_alpha: f64,
 }
 
 impl BoundLoad {
@@ -183,7 +185,33 @@ impl BoundLoad {
             q_basis,
             weights: vec![0.0; k],
             dweights: vec![0.0; k],
+            weights_alpha: f64::NAN,
         })
+    }
+
+    /// The magnitude of the terms that make up `q(α)`: `max_k Σ_j |w_j(α)| |q_j,k|`
+    /// (affine: `w = (1, α)`; basis: the weights last evaluated, if at this α). Rounding
+    /// errors in `q(α)` are proportional to it, not to `|q(α)|`, which can cancel to zero.
+    /// `None` for a general load (or basis weights not evaluated at α).
+    pub(crate) fn term_magnitude(&self, alpha: f64) -> Option<f64> {
+        let w: Vec<f64> = match &self.load {
+            Load::Affine { .. } => vec![1.0, alpha.abs()],
+            Load::Basis { .. } if self.weights_alpha == alpha => {
+                self.weights.iter().map(|w| w.abs()).collect()
+            }
+            _ => return None,
+        };
+        let m = self.q_basis.first()?.len();
+        let mut mag = 0.0f64;
+        for k in 0..m {
+            let t: f64 = w
+                .iter()
+                .zip(&self.q_basis)
+                .map(|(wj, qj)| wj * qj[k].abs())
+                .sum();
+            mag = mag.max(t);
+        }
+        Some(mag)
     }
 
     /// True when `f` (hence `q`) is affine in α.
@@ -195,6 +223,7 @@ impl BoundLoad {
         let Load::Basis { weights, .. } = &mut self.load else {
             return Ok(());
         };
+        self.weights_alpha = f64::NAN;
         weights(alpha, &mut self.weights, &mut self.dweights).map_err(|e| Error::Load {
             alpha,
             code: e.code,
@@ -212,6 +241,7 @@ impl BoundLoad {
                 message: "the basis weights returned a NaN or infinite value".into(),
             });
         }
+        self.weights_alpha = alpha;
         Ok(())
     }
 

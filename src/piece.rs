@@ -76,8 +76,10 @@ impl LinForm {
         }
         let Term { index: j, coef: c } = self.disp;
         if c != 0.0 {
+            // Row j of the symmetric W, read as its (contiguous) column j.
+            let col = w.col(j);
             for k in 0..m {
-                out[k] += c * w[(j, k)];
+                out[k] += c * col[k];
             }
             out[m] = c * dq[j];
         }
@@ -232,17 +234,18 @@ impl<'a> PieceConstants<'a> {
     }
 }
 
-/// `d = q − (g, 0) + W λ`.
+/// `d = q − (g, 0) + W λ` (one matrix-vector product with faer).
 pub(crate) fn displacement_gaps(w: MatRef<'_, f64>, q_minus_g: &[f64], lam: &[f64]) -> Vec<f64> {
     let m = q_minus_g.len();
     let mut d = q_minus_g.to_vec();
-    for (k, &l) in lam.iter().enumerate() {
-        if l != 0.0 {
-            for (i, di) in d.iter_mut().enumerate().take(m) {
-                *di += w[(i, k)] * l;
-            }
-        }
-    }
+    faer::linalg::matmul::matmul(
+        faer::MatMut::from_column_major_slice_mut(&mut d, m, 1),
+        faer::Accum::Add,
+        w,
+        MatRef::from_column_major_slice(lam, lam.len(), 1),
+        1.0,
+        faer::Par::Seq,
+    );
     d
 }
 

@@ -15,6 +15,7 @@ use faer::MatRef;
 
 use crate::class::Class;
 use crate::error::{Error, Result};
+use crate::path::update::{self, UpdatedLu};
 use crate::piece::{DenseLu, PieceConstants, displacement_gaps};
 
 /// Relative residual accepted as a solution.
@@ -130,6 +131,52 @@ pub(crate) fn solve_piece(
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
+/// Piece solves at fixed α by updates of the last factorisation (see
+/// [`crate::path::update`]).
+struct PieceSolves<'a> {
+    c: &'a PieceConstants<'a>,
+    w: MatRef<'a, f64>,
+    lu: Option<UpdatedLu>,
+    row_bound: f64,
+}
+
+impl<'a> PieceSolves<'a> {
+    fn new(c: &'a PieceConstants<'a>, w: MatRef<'a, f64>) -> Self {
+        Self {
+            c,
+            w,
+            lu: None,
+            row_bound: update::row_bound(c, w),
+        }
+    }
+
+    /// As [`solve_piece`].
+    fn solve(&mut self, classes: &[Class], qg: &[f64]) -> Option<Vec<f64>> {
+        let rhs = self.c.piece_rhs(classes, qg);
+        let m = 2 * self.c.p;
+        let extended = self
+            .lu
+            .as_ref()
+            .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
+            .and_then(|u| u.extend(self.c, self.w, classes));
+        if let Some(u) = extended {
+            let (x, rel) = u.solve_checked(self.c, self.w, &rhs, self.row_bound);
+            if rel <= 1e-12 && x.iter().all(|v| v.is_finite()) {
+                self.lu = Some(u);
+                return Some(x);
+            }
+        }
+        // A fresh factorisation, with the singularity test of solve_piece.
+        let u = UpdatedLu::factor(self.c, self.w, classes)?;
+        if u.pivot_ratio() < 1e-14 {
+            return None;
+        }
+        let (x, _) = u.solve_checked(self.c, self.w, &rhs, self.row_bound);
+        self.lu = Some(u);
+        x.iter().all(|v| v.is_finite()).then_some(x)
+    }
+}
+
 /// Semi-smooth Newton with Armijo backtracking. Returns the last iterate and whether it
 /// converged, plus a short description.
 fn newton(
@@ -142,12 +189,16 @@ fn newton(
 ) -> (Vec<f64>, bool, String) {
     let mut lam = lam0;
     let mut phi = merit(c, w, qg, &lam, fr);
+    // Consecutive Newton steps usually change the classes of a few nodes: their piece
+    // matrices are solved by rank-2 updates of one factorisation (O(m²) each), with a
+    // fresh factorisation when many nodes changed or an update loses accuracy.
+    let mut pieces = PieceSolves::new(c, w);
     for it in 0..max_iter {
         if rel_residual(c, w, qg, &lam, fr) <= TOL {
             return (lam, true, format!("Newton converged in {it} iterations"));
         }
         let classes = active_classes(c, w, qg, &lam, fr);
-        let Some(ln) = solve_piece(c, w, &classes, qg) else {
+        let Some(ln) = pieces.solve(&classes, qg) else {
             return (
                 lam,
                 false,
@@ -332,6 +383,21 @@ pub(crate) fn solve_with_frozen(
         return Ok(lam);
     }
     notes.push(msg);
+    // Newton stalls where its merit function is not smooth (classes change): a few block
+    // Gauss-Seidel sweeps move the iterate off such a kink, and Newton resumes from there.
+    // Rounds of both before the long Gauss-Seidel run below (each sweep is O(m²)).
+    let mut lam = lam;
+    for round in 0..20 {
+        let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20, fr);
+        let (l, ok, msg) = newton(&c, w, qg, lam_gs, 50, fr);
+        if ok {
+            return Ok(l);
+        }
+        lam = l;
+        if round == 19 {
+            notes.push(format!("after 20 rounds of 20 sweeps and Newton: {msg}"));
+        }
+    }
     let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20_000, fr);
     let (lam, ok, msg) = newton(&c, w, qg, lam_gs, 200, fr);
     if ok {

@@ -32,8 +32,7 @@ impl Path {
         let c = self.consts();
         let m = 2 * c.p;
         let w = self.problem.delassus().w();
-        let qg = shift_gap(&pt.q, self.problem.gap());
-        let d = displacement_gaps(w, &qg, &pt.lam);
+        let d = self.gaps(pt);
         let (lt, dt) = match t {
             Some(t) => {
                 let mut dd = displacement_gaps(w, &vec![0.0; m], &t[..m]);
@@ -126,12 +125,16 @@ impl Path {
                             .map(|(a, b)| a * b)
                             .sum::<f64>()
                         - row[m] * cur.alpha;
-                    let (sc, a_s) = (cur.scales.force, cur.scales.alpha);
-                    let mut xp = cur.lu.particular(&rhs);
-                    for v in xp.iter_mut().take(m) {
-                        *v *= sc;
-                    }
-                    xp[m] *= a_s;
+                    let dq_col = self.alpha_column(&cur.classes, &pt.dq);
+                    let xp = cur.lu.particular_raw(
+                        &c,
+                        w,
+                        &rhs,
+                        cur.alpha,
+                        &dq_col,
+                        cur.scales,
+                        self.row_bound(),
+                    );
                     let dot = |x: &[f64]| row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
                     let tau = (-c0 - dot(&xp)) / dot(&cur.t);
                     let x: Vec<f64> = xp.iter().zip(&cur.t).map(|(a, b)| a + tau * b).collect();
@@ -160,20 +163,39 @@ impl Path {
         let (lo, hi) = self.window();
         let bound = if dir > 0.0 { hi } else { lo };
         let span = self.alpha_scale();
-        let mlu = {
-            let c = self.consts();
-            DenseLu::new(
-                c.piece_matrix(self.problem.delassus().w(), &cur.classes)
-                    .as_ref(),
-            )
+        // M_S solves: by the piece's updated factorisation, or one LU of M_S.
+        let dense = match &*cur.lu {
+            PieceSolver::Updated(_) => None,
+            PieceSolver::Full(_) => {
+                let c = self.consts();
+                Some(DenseLu::new(
+                    c.piece_matrix(self.problem.delassus().w(), &cur.classes)
+                        .as_ref(),
+                ))
+            }
+        };
+        let msolve = |this: &Self, b: &[f64]| -> Vec<f64> {
+            match (&dense, &*cur.lu) {
+                (Some(lu), _) => lu.solve(b),
+                (None, PieceSolver::Updated(u)) => {
+                    u.solve_checked(
+                        &this.consts(),
+                        this.problem.delassus().w(),
+                        b,
+                        this.row_bound(),
+                    )
+                    .0
+                }
+                (None, PieceSolver::Full(_)) => unreachable!("a full solver has its dense LU"),
+            }
         };
         let classes = cur.classes.clone();
         let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<GuardRow>)> {
             let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
             let c = this.consts();
             let qg = shift_gap(&q, this.problem.gap());
-            let lam = mlu.solve(&c.piece_rhs(&classes, &qg));
-            let dl = mlu.solve(&c.piece_rhs(&classes, &dq));
+            let lam = msolve(this, &c.piece_rhs(&classes, &qg));
+            let dl = msolve(this, &c.piece_rhs(&classes, &dq));
             let mut t = dl;
             t.push(1.0);
             let pt = Point { lam, alpha, q, dq };

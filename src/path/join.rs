@@ -6,13 +6,14 @@ use super::advance::GuardRow;
 use super::*;
 
 impl Path {
-    /// Classes of node `i` whose equations and guards hold at the point (to `tol`, in
-    /// force units).
-    pub(super) fn compatible(&self, i: usize, pt: &Point, tol: f64) -> Vec<Class> {
-        let w = self.problem.delassus().w();
-        let qg = shift_gap(&pt.q, self.problem.gap());
-        let d = displacement_gaps(w, &qg, &pt.lam);
-        self.compatible_at(i, &pt.lam, &d, tol)
+    /// Classes of each node in `nodes` whose equations and guards hold at the point (to
+    /// `tol`, in force units). One product with W for all of them.
+    pub(super) fn compatible(&self, nodes: &[usize], pt: &Point, tol: f64) -> Vec<Vec<Class>> {
+        let d = self.gaps(pt);
+        nodes
+            .iter()
+            .map(|&i| self.compatible_at(i, &pt.lam, &d, tol))
+            .collect()
     }
 
     /// Classes of node `i` compatible with `(λ, d)` (to `tol`, in force units).
@@ -59,10 +60,18 @@ impl Path {
         if back.is_some_and(|(bc, _)| bc == classes) {
             return;
         }
-        let Some((t, lu, scales)) = self.tangent(classes, pt, scale) else {
+        let Some(PieceTangent {
+            t,
+            lu,
+            scales,
+            orientation: lu_orientation,
+        }) = self.tangent(classes, pt, scale)
+        else {
             return;
         };
         let lu = Arc::new(lu);
+        // One table along t; along −t the slopes change sign.
+        let table = self.guard_table(classes, pt, Some(&t));
         for s in [1.0, -1.0] {
             let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
             if out.iter().any(|c| {
@@ -70,8 +79,8 @@ impl Path {
             }) {
                 continue;
             }
-            let enters = self.guard_table(classes, pt, Some(&ts)).iter().all(|row| {
-                let (v, vd) = (row.value, row.slope);
+            let enters = table.iter().all(|row| {
+                let (v, vd) = (row.value, s * row.slope);
                 if v > tol {
                     true
                 } else if v < -tol {
@@ -84,12 +93,12 @@ impl Path {
             });
             if enters {
                 let orientation = if s > 0.0 {
-                    lu.orientation
+                    lu_orientation
                 } else {
-                    -lu.orientation
+                    -lu_orientation
                 };
                 let m = ts.len() - 1;
-                let det_sign = if ts[m].abs() <= 1e-14 {
+                let det_sign = if scales.is_vertical(&ts) {
                     0
                 } else {
                     orientation * sign(ts[m])
@@ -124,7 +133,7 @@ impl Path {
     ) -> Result<Vec<Candidate>> {
         let scale = self.force_scale(pt);
         let tol = self.opts.zero_tol * scale;
-        let options: Vec<Vec<Class>> = nodes.iter().map(|&i| self.compatible(i, pt, tol)).collect();
+        let options: Vec<Vec<Class>> = self.compatible(nodes, pt, tol);
         if let Some(k) = options.iter().position(|o| o.is_empty()) {
             return Err(Error::Numerical(format!(
                 "node {} fits no class at alpha = {:e} (the point is not a solution)",
@@ -274,7 +283,11 @@ impl Path {
             .iter()
             .map(|c| Branch {
                 classes: c.classes.clone(),
-                direction: sign(if c.t[m].abs() <= 1e-14 { 0.0 } else { c.t[m] }),
+                direction: if c.scales.is_vertical(&c.t) {
+                    0
+                } else {
+                    sign(c.t[m])
+                },
                 orientation_preserving: c.orientation == sigma,
             })
             .collect();
@@ -317,7 +330,12 @@ impl Path {
     /// returned unchanged.
     pub(super) fn snap_to_vertex(&mut self, pt: Point, tol: f64) -> Result<Point> {
         let p = self.problem.p();
-        if inf_norm(&pt.lam) > tol || (0..p).any(|i| self.compatible(i, &pt, tol).len() < 4) {
+        if inf_norm(&pt.lam) > tol
+            || self
+                .compatible(&(0..p).collect::<Vec<_>>(), &pt, tol)
+                .iter()
+                .any(|c| c.len() < 4)
+        {
             return Ok(pt);
         }
         let m = 2 * p;
@@ -348,15 +366,16 @@ impl Path {
     pub(super) fn apply(&mut self, pend: &PendingJoin, k: usize) -> Result<StepOutcome> {
         let m = 2 * self.problem.p();
         let cand = pend.cands[k].clone();
+        self.commit_solver(&cand.lu);
         let pt = pend.point.clone();
-        let dir = if cand.t[m].abs() <= 1e-14 {
+        let dir = if cand.scales.is_vertical(&cand.t) {
             0
         } else {
             sign(cand.t[m])
         };
         let fold = dir != 0 && pend.last_dir != 0 && dir != pend.last_dir;
         let scale = self.force_scale(&pt);
-        let a_s = self.alpha_scale();
+        let a_s = cand.scales.alpha;
         let p = self.problem.p();
         let snapshot = self.load.snapshot(pt.alpha)?;
         let tr = self.trace.as_mut().expect("started");

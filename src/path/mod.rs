@@ -12,6 +12,7 @@ mod advance;
 mod join;
 mod query;
 mod roots;
+pub(crate) mod update;
 
 use advance::Exit;
 
@@ -23,6 +24,8 @@ use crate::load::{BoundLoad, Load, LoadSnapshot};
 use crate::piece::{DenseLu, Guard, PieceConstants, PieceLu, displacement_gaps, shift_gap};
 use crate::problem::Problem;
 use crate::solve::{solve_fixed_alpha, solve_with_frozen};
+use std::cell::{Cell, RefCell};
+use update::UpdatedLu;
 
 /// Options of a path. Build with [`PathOptions::window`] and adjust the fields.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,6 +43,10 @@ pub struct PathOptions {
     /// (default 1e-11, relative to the force scale of the current point; displacement
     /// guards are compared after multiplication by [`Problem::default_r`]).
     pub zero_tol: f64,
+    /// Factorise every piece matrix afresh (O(m³) per piece, m = 2p) instead of updating
+    /// one factorised base by rank-2 changes (O(m²) per piece; default `false`). The
+    /// fresh factorisations are the reference the updated ones are tested against.
+    pub fresh_factorisations: bool,
 }
 
 impl PathOptions {
@@ -50,6 +57,7 @@ impl PathOptions {
             alpha_end,
             max_steps: 10_000,
             zero_tol: 1e-11,
+            fresh_factorisations: false,
         }
     }
 }
@@ -203,6 +211,15 @@ pub struct Path {
     load: BoundLoad,
     opts: PathOptions,
     trace: Option<Trace>,
+    /// The factorisation the next pieces are updated from (see [`update`]).
+    updater: RefCell<Option<UpdatedLu>>,
+    /// Fresh factorisations of a base piece matrix so far.
+    refactorisations: Cell<usize>,
+    /// Bound on the row sums of any piece matrix, computed on first use.
+    row_bound: Cell<Option<f64>>,
+    /// The last `d = q − (g, 0) + W λ` with its (α, λ): every candidate piece at a
+    /// transition point needs it.
+    gaps_cache: RefCell<Option<GapsAt>>,
 }
 
 /// The traced data and the current position.
@@ -228,6 +245,9 @@ struct Trace {
     branches: Vec<Branch>,
 }
 
+/// `d` at a point `(α, λ)`.
+type GapsAt = (f64, Vec<f64>, Arc<Vec<f64>>);
+
 /// Position on the current piece.
 #[derive(Clone)]
 struct CurrentPiece {
@@ -236,8 +256,8 @@ struct CurrentPiece {
     alpha: f64,
     /// Tangent (λ̇, α̇), unit in scaled coordinates, oriented along the path.
     t: Vec<f64>,
-    /// Factorisation of the piece Jacobian in scaled coordinates, with the scales.
-    lu: Arc<PieceLu>,
+    /// Factorisation of the piece, with the scales of its Jacobian.
+    lu: Arc<PieceSolver>,
     scales: JacobianScaling,
 }
 
@@ -266,8 +286,67 @@ struct Candidate {
     t: Vec<f64>,
     orientation: i8,
     det_sign: i8,
-    lu: Arc<PieceLu>,
+    lu: Arc<PieceSolver>,
     scales: JacobianScaling,
+}
+
+/// How a piece's equations are solved: a full-pivoting LU of the Jacobian in scaled
+/// coordinates (vertical pieces, and every piece when
+/// [`PathOptions::fresh_factorisations`] is set), or `M_S` by updates of a base.
+enum PieceSolver {
+    Full(PieceLu),
+    Updated(UpdatedLu),
+}
+
+impl PieceSolver {
+    /// A solution `x` (raw coordinates (λ, α)) of `J x = b`. The updated form returns the
+    /// one at `near_alpha` (`x_α = near_alpha`, the α of the current point), so that no cancellation
+    /// with a far-away α = 0 enters.
+    #[allow(clippy::too_many_arguments)]
+    fn particular_raw(
+        &self,
+        c: &PieceConstants<'_>,
+        w: faer::MatRef<'_, f64>,
+        b: &[f64],
+        near_alpha: f64,
+        dq_col: &[f64],
+        scales: JacobianScaling,
+        row_bound: f64,
+    ) -> Vec<f64> {
+        match self {
+            PieceSolver::Full(lu) => {
+                let m = b.len();
+                let mut x = lu.particular(b);
+                for v in x.iter_mut().take(m) {
+                    *v *= scales.force;
+                }
+                x[m] *= scales.alpha;
+                x
+            }
+            PieceSolver::Updated(u) => {
+                // M λ = b − c α with α = near_alpha.
+                let alpha = near_alpha;
+                let rhs: Vec<f64> = b
+                    .iter()
+                    .zip(dq_col)
+                    .map(|(bi, ci)| bi - ci * alpha)
+                    .collect();
+                let (mut x, _) = u.solve_checked(c, w, &rhs, row_bound);
+                x.push(alpha);
+                x
+            }
+        }
+    }
+}
+
+/// A piece's tangent at a point with its factorisation.
+struct PieceTangent {
+    /// Unit in scaled coordinates, given in raw coordinates.
+    t: Vec<f64>,
+    lu: PieceSolver,
+    scales: JacobianScaling,
+    /// `sign det [J_S; tᵀ]`.
+    orientation: i8,
 }
 
 /// The scaling of a piece Jacobian: λ is measured in units of `force`, α in units of
@@ -276,6 +355,13 @@ struct Candidate {
 struct JacobianScaling {
     force: f64,
     alpha: f64,
+}
+
+impl JacobianScaling {
+    /// A tangent (raw coordinates) along which α does not move to working accuracy.
+    fn is_vertical(&self, t: &[f64]) -> bool {
+        t[t.len() - 1].abs() / self.alpha <= 1e-14
+    }
 }
 
 /// Where the path entered a piece (for closed-loop detection).
@@ -330,6 +416,10 @@ impl Path {
             load,
             opts,
             trace: None,
+            updater: RefCell::new(None),
+            refactorisations: Cell::new(0),
+            row_bound: Cell::new(None),
+            gaps_cache: RefCell::new(None),
         })
     }
 
@@ -361,15 +451,34 @@ impl Path {
         Ok(Point { lam, alpha, q, dq })
     }
 
-    /// Force scale of a point: max(‖λ‖∞, r0 ‖q − (g, 0)‖∞, r0 ‖q'‖∞ |α_end − α_start|).
-    /// The last term keeps the scale meaningful where the load passes through zero.
+    /// Force scale of a point, from the point alone (never from the window):
+    /// `max(‖λ‖∞, r0 ‖q − (g, 0)‖∞, r0 (T + ‖g‖∞))` with T the magnitude of the terms that
+    /// make up q(α) (see [`BoundLoad::term_magnitude`]): where the load passes through zero
+    /// the rounding of q is still proportional to T.
     fn force_scale(&self, pt: &Point) -> f64 {
         let r0 = self.problem.default_r();
         let qg = shift_gap(&pt.q, self.problem.gap());
+        let terms = self
+            .load
+            .term_magnitude(pt.alpha)
+            .map_or(0.0, |t| t + inf_norm(self.problem.gap()));
         inf_norm(&pt.lam)
             .max(r0 * inf_norm(&qg))
-            .max(r0 * inf_norm(&pt.dq) * self.alpha_scale())
+            .max(r0 * terms)
             .max(1e-300)
+    }
+
+    /// The unit of α at a point: the change of α that moves the load by the force scale,
+    /// `scale / (r0 ‖q'‖∞)` (the window's length where q' = 0). Tangents are unit vectors
+    /// in λ / scale and α / unit, and "vertical" means a negligible α component there.
+    fn alpha_unit(&self, pt: &Point, scale: f64) -> f64 {
+        let rate = self.problem.default_r() * inf_norm(&pt.dq);
+        let unit = scale / rate;
+        if unit.is_finite() && unit > 0.0 {
+            unit
+        } else {
+            self.alpha_scale()
+        }
     }
 
     fn state(&mut self, lam: &[f64], alpha: f64, classes: &[Class]) -> Result<State> {
@@ -394,40 +503,161 @@ impl Path {
         }
     }
 
-    /// Tangent of piece `classes` at `pt` in raw coordinates, from the factorisation of
-    /// the Jacobian in scaled coordinates (λ/S, α/A) where the tangent is a unit vector.
-    /// Returns (t, factorisation, scaling) or None when the Jacobian has rank < 2p.
-    fn tangent(
+    /// The α column `∂H/∂α` of the piece Jacobian (raw coordinates).
+    fn alpha_column(&self, classes: &[Class], dq: &[f64]) -> Vec<f64> {
+        let c = self.consts();
+        let mut col = vec![0.0; 2 * c.p];
+        for (i, &cl) in classes.iter().enumerate() {
+            let [nu, t] = c.equations(i, cl);
+            col[i] = nu.disp.coef * dq[nu.disp.index];
+            col[c.p + i] = t.disp.coef * dq[t.disp.index];
+        }
+        col
+    }
+
+    /// `d = q − (g, 0) + W λ` at a point (one product with W, cached for the last point).
+    fn gaps(&self, pt: &Point) -> Arc<Vec<f64>> {
+        if let Some((a, lam, d)) = &*self.gaps_cache.borrow()
+            && *a == pt.alpha
+            && *lam == pt.lam
+        {
+            return d.clone();
+        }
+        let qg = shift_gap(&pt.q, self.problem.gap());
+        let d = Arc::new(displacement_gaps(self.problem.delassus().w(), &qg, &pt.lam));
+        *self.gaps_cache.borrow_mut() = Some((pt.alpha, pt.lam.clone(), d.clone()));
+        d
+    }
+
+    /// Bound on the absolute row sums of every piece matrix (for residual checks).
+    fn row_bound(&self) -> f64 {
+        if let Some(b) = self.row_bound.get() {
+            return b;
+        }
+        let b = update::row_bound(&self.consts(), self.problem.delassus().w());
+        self.row_bound.set(Some(b));
+        b
+    }
+
+    /// The path moves onto a piece: later pieces are updated from its factorisation.
+    fn commit_solver(&self, lu: &PieceSolver) {
+        if let PieceSolver::Updated(u) = lu {
+            *self.updater.borrow_mut() = Some(u.clone());
+        }
+    }
+
+    /// Fresh factorisations of a base piece matrix so far on this path (each O(m³); the
+    /// pieces between them cost O(m²) each). With
+    /// [`PathOptions::fresh_factorisations`], fresh factorisations of the Jacobians are
+    /// not counted.
+    pub fn refactorisations(&self) -> usize {
+        self.refactorisations.get()
+    }
+
+    /// Tangent of piece `classes` at `pt` in raw coordinates, unit in the scaled
+    /// coordinates (λ/S, α/A). By an update of the current base when `M_S` is regular
+    /// (O(m²)); by a full-pivoting LU of the Jacobian otherwise (a vertical piece) or on
+    /// request. `None` when the Jacobian has rank < 2p.
+    fn tangent(&self, classes: &[Class], pt: &Point, scale: f64) -> Option<PieceTangent> {
+        let scales = JacobianScaling {
+            force: scale,
+            alpha: self.alpha_unit(pt, scale),
+        };
+        if !self.opts.fresh_factorisations
+            && let Some(t) = self.tangent_updated(classes, pt, scales)
+        {
+            return Some(t);
+        }
+        self.tangent_full(classes, pt, scales)
+    }
+
+    /// The tangent from `M_S y = −∂H/∂α` (t ∝ (y, 1)); `None` when `M_S` is singular or
+    /// so close to it that the piece is vertical to working accuracy.
+    fn tangent_updated(
         &self,
         classes: &[Class],
         pt: &Point,
-        scale: f64,
-    ) -> Option<(Vec<f64>, PieceLu, JacobianScaling)> {
+        scales: JacobianScaling,
+    ) -> Option<PieceTangent> {
+        let c = self.consts();
+        let w = self.problem.delassus().w();
+        let m = 2 * c.p;
+        let rb = self.row_bound();
+        let neg: Vec<f64> = self
+            .alpha_column(classes, &pt.dq)
+            .iter()
+            .map(|v| -v)
+            .collect();
+        let solve = |u: &UpdatedLu| {
+            let (y, rel) = u.solve_checked(&c, w, &neg, rb);
+            (rel <= 1e-12).then_some(y)
+        };
+        let extended = self
+            .updater
+            .borrow()
+            .as_ref()
+            .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
+            .and_then(|u| u.extend(&c, w, classes));
+        let (upd, y, fresh) = match extended.and_then(|u| solve(&u).map(|y| (u, y))) {
+            Some((u, y)) => (u, y, false),
+            None => {
+                let u = UpdatedLu::factor(&c, w, classes)?;
+                self.refactorisations.set(self.refactorisations.get() + 1);
+                let y = solve(&u)?;
+                (u, y, true)
+            }
+        };
+        // Unit tangent in scaled coordinates, (y/S, 1/A) normalised.
+        let mut t: Vec<f64> = y.iter().map(|v| v / scales.force).collect();
+        t.push(1.0 / scales.alpha);
+        let norm = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !(norm.is_finite() && norm > 0.0) || t[m] / norm <= 1e-13 {
+            return None;
+        }
+        for v in t.iter_mut().take(m) {
+            *v *= scales.force / norm;
+        }
+        t[m] *= scales.alpha / norm;
+        if fresh {
+            *self.updater.borrow_mut() = Some(upd.clone());
+        }
+        Some(PieceTangent {
+            t,
+            orientation: upd.det_sign(),
+            lu: PieceSolver::Updated(upd),
+            scales,
+        })
+    }
+
+    /// The tangent from a full-pivoting LU of the Jacobian in scaled coordinates.
+    fn tangent_full(
+        &self,
+        classes: &[Class],
+        pt: &Point,
+        scales: JacobianScaling,
+    ) -> Option<PieceTangent> {
         let c = self.consts();
         let m = 2 * c.p;
         let qg = shift_gap(&pt.q, self.problem.gap());
         let (mut js, _) = c.jacobian(self.problem.delassus().w(), classes, &qg, &pt.dq, pt.alpha);
-        let a_s = self.alpha_scale();
         for r in 0..m {
             for col in 0..m {
-                js[(r, col)] *= scale;
+                js[(r, col)] *= scales.force;
             }
-            js[(r, m)] *= a_s;
+            js[(r, m)] *= scales.alpha;
         }
         let lu = PieceLu::new(js.as_ref())?;
         let mut t = lu.t.clone();
         for v in t.iter_mut().take(m) {
-            *v *= scale;
+            *v *= scales.force;
         }
-        t[m] *= a_s;
-        Some((
+        t[m] *= scales.alpha;
+        Some(PieceTangent {
             t,
-            lu,
-            JacobianScaling {
-                force: scale,
-                alpha: a_s,
-            },
-        ))
+            orientation: lu.orientation,
+            lu: PieceSolver::Full(lu),
+            scales,
+        })
     }
 
     /// Starts (or restarts) the path at `alpha` with the fixed-α solver, from `guess`
@@ -466,8 +696,8 @@ impl Path {
         let p = self.problem.p();
         let mut fixed = vec![Class::Open; p];
         let mut nodes = Vec::new();
-        for i in 0..p {
-            let comp = self.compatible(i, &pt, tol);
+        let all = self.compatible(&(0..p).collect::<Vec<_>>(), &pt, tol);
+        for (i, comp) in all.into_iter().enumerate() {
             match comp.len() {
                 0 => {
                     return Err(Error::SolveFailed {
@@ -488,7 +718,7 @@ impl Path {
         let pick = cands
             .iter()
             .position(|c| sign(c.t[ms]) == want)
-            .or_else(|| cands.iter().position(|c| c.t[ms].abs() <= 1e-14));
+            .or_else(|| cands.iter().position(|c| c.scales.is_vertical(&c.t)));
         let Some(k) = pick else {
             return Err(Error::Numerical(format!(
                 "no piece leaves the start point alpha = {alpha} toward alpha_end = {}",
@@ -496,8 +726,13 @@ impl Path {
             )));
         };
         let cand = cands[k].clone();
+        self.commit_solver(&cand.lu);
         let start = self.state(&pt.lam, alpha, &cand.classes)?;
-        let dir = sign(cand.t[ms]);
+        let dir = if cand.scales.is_vertical(&cand.t) {
+            0
+        } else {
+            sign(cand.t[ms])
+        };
         let piece = PieceRecord {
             classes: cand.classes.clone(),
             alpha_from: alpha,
@@ -580,8 +815,7 @@ impl Path {
             }
         }
         let cur = self.trace.as_ref().expect("started").cur.clone();
-        let m = 2 * self.problem.p();
-        let vertical = cur.t[m].abs() <= 1e-14;
+        let vertical = cur.scales.is_vertical(&cur.t);
         let exit = if self.load.is_affine() || vertical {
             self.exit_linear(&cur)?
         } else {

@@ -68,14 +68,16 @@ impl Path {
     }
 
     /// Every traced solution at `alpha`: one per traced piece whose α-range contains it
-    /// (several past a fold), each by one small solve on the stored piece plus one
-    /// back-solve for u. Points shared by two pieces (transition points) are reported
+    /// (several past a fold), each by interpolation between the piece's end points for an
+    /// affine load (exact: a piece is then a segment), or one solve with the piece matrix
+    /// (O(m³)) otherwise, plus one back-solve for u. Points shared by two pieces (transition points) are reported
     /// once. Empty if the traced path never reached `alpha`. Errors: not started, load
     /// failure.
     pub fn solutions_at(&mut self, alpha: f64) -> Result<Vec<Solution>> {
         let pieces = self.trace_ref()?.pieces.clone();
         let m = 2 * self.problem.p();
-        let a_tol = 1e-12 * self.alpha_scale().max(alpha.abs());
+        // Matching α with a piece's ends: relative to α and to the piece's own extent,
+        // never to the window.
         let pt0 = self.point_at(vec![0.0; m], alpha)?;
         let qg = shift_gap(&pt0.q, self.problem.gap());
         let mut out: Vec<Solution> = Vec::new();
@@ -84,6 +86,7 @@ impl Path {
                 pc.alpha_from.min(pc.alpha_to),
                 pc.alpha_from.max(pc.alpha_to),
             );
+            let a_tol = 1e-12 * alpha.abs().max(hi - lo);
             if !(alpha >= lo - a_tol && alpha <= hi + a_tol) {
                 continue;
             }
@@ -96,6 +99,17 @@ impl Path {
                 lams.push(pc.lambda_from.clone());
             } else if (alpha - pc.alpha_to).abs() <= a_tol {
                 lams.push(pc.lambda_to.clone());
+            } else if self.load.is_affine() {
+                // Under an affine load a piece is a segment in (λ, α): exact from its ends,
+                // no factorisation.
+                let s = (alpha - pc.alpha_from) / (pc.alpha_to - pc.alpha_from);
+                lams.push(
+                    pc.lambda_from
+                        .iter()
+                        .zip(&pc.lambda_to)
+                        .map(|(a, b)| a + s * (b - a))
+                        .collect(),
+                );
             } else {
                 let c = self.consts();
                 let w = self.problem.delassus().w();

@@ -1,0 +1,104 @@
+//! Benchmark (not a test): time per transition on thin strips as p grows.
+//!
+//! ```text
+//! cargo bench --bench strips                  # p = 240, 480, 960, 1920
+//! cargo bench --bench strips -- 240 480       # chosen sizes
+//! FRICONT_BENCH_FRESH=480 cargo bench --bench strips   # also fresh factorisations up to p = 480
+//! ```
+//!
+//! Each strip is the rectangle generator's press-shear case with `p + 1 × 4` nodes on
+//! `(0, p/40) × (0, 0.1)` (n = 8p dofs, p contact nodes along the bottom). The trace starts
+//! at the window's start and runs to the end of the path; printed: transitions, end
+//! reason, set-up and trace times, time per transition, fresh factorisations of a base
+//! piece matrix, and the peak resident memory of the process so far. With
+//! `FRICONT_BENCH_FRESH=P`, strips with p ≤ P are traced a second time with a fresh
+//! factorisation of every piece (the reference tracer) for the ratio.
+
+use std::path::{Path as FsPath, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use fricont::path::{Path, PathOptions};
+use fricont_exchange::generator::{RectSpec, generate};
+use fricont_exchange::io::CaseData;
+
+fn peak_mib() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = s.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+fn strip(dir: &FsPath, p: usize) -> PathBuf {
+    let d = dir.join(format!("strip-p{p}"));
+    if !d.join("A.mtx").exists() {
+        let spec = RectSpec {
+            nx: p + 1,
+            ny: 4,
+            lx: p as f64 / 40.0,
+            ly: 0.1,
+            ..RectSpec::press_shear()
+        };
+        let case = generate(&spec).unwrap_or_else(|e| panic!("generate p = {p}: {e}"));
+        case.write_dir(&d)
+            .unwrap_or_else(|e| panic!("write {}: {e}", d.display()));
+    }
+    d
+}
+
+fn trace(case: &CaseData, fresh: bool) -> (usize, String, f64, f64, usize) {
+    let t = Instant::now();
+    let problem = Arc::new(case.problem(None).expect("problem"));
+    let mut opts = PathOptions::window(case.alpha_start, case.alpha_end);
+    opts.fresh_factorisations = fresh;
+    let mut path = Path::new(problem, case.load().expect("load"), opts).expect("path");
+    let setup = t.elapsed().as_secs_f64();
+    let t = Instant::now();
+    let end = match path.start(case.alpha_start, None).and_then(|_| path.run()) {
+        Ok(_) => path
+            .end_reason()
+            .map_or("none".to_string(), |r| r.name().to_string()),
+        Err(e) => format!("failed: {e}"),
+    };
+    let secs = t.elapsed().as_secs_f64();
+    let transitions = path.events().last().map_or(0, |e| e.transition + 1);
+    (transitions, end, setup, secs, path.refactorisations())
+}
+
+fn main() {
+    let sizes: Vec<usize> = std::env::args()
+        .skip(1)
+        .filter_map(|a| a.parse().ok())
+        .collect();
+    let sizes = if sizes.is_empty() {
+        vec![240, 480, 960, 1920]
+    } else {
+        sizes
+    };
+    let fresh_up_to: usize = std::env::var("FRICONT_BENCH_FRESH")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
+    let tmp = std::env::temp_dir().join("fricont-bench-strips");
+    println!(
+        "{:>6} {:>7} {:>11} {:>9} {:>9} {:>12} {:>8} {:>9}  end",
+        "p", "n", "transitions", "setup s", "trace s", "ms/transit.", "refact.", "peak MiB"
+    );
+    for &p in &sizes {
+        let dir = strip(&tmp, p);
+        let case = CaseData::read_dir(&dir).expect("read");
+        let mut runs = vec![("updated", false)];
+        if p <= fresh_up_to {
+            runs.push(("fresh", true));
+        }
+        for (name, fresh) in runs {
+            let (tr, end, setup, secs, refact) = trace(&case, fresh);
+            println!(
+                "{p:>6} {:>7} {tr:>11} {setup:>9.2} {secs:>9.2} {:>12.2} {refact:>8} {:>9.0}  {end} ({name})",
+                case.a.nrows(),
+                1e3 * secs / tr.max(1) as f64,
+                peak_mib().unwrap_or(f64::NAN)
+            );
+        }
+    }
+}

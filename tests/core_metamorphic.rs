@@ -1,0 +1,207 @@
+//! Metamorphic tests: transformations that must not change the answer, each checked
+//! against the unmodified problem (no stored numbers).
+//!
+//! * Far window ends: moving only the far end of the window (to 1e3 … 1e12) leaves the
+//!   start and every event inside the original window unchanged — the original events
+//!   are a prefix of the far-window events.
+//! * Global force scaling: `f ↦ s f`, `g ↦ s g` (s = 1e-9 … 1e9) gives the same α and
+//!   `λ ↦ s λ`.
+//! * Global stiffness scaling: `A ↦ s A`, `g ↦ g / s` gives the same α and λ.
+//! * Node permutation: permuting the rows of N and T (with friction and gap) permutes
+//!   the event nodes and nothing else.
+
+mod common;
+
+use std::sync::Arc;
+
+use common::{Data, Rng, random_case, read_mtx, read_vec, trace};
+use fricont::{CsrMatrix, Event, Path, ProblemBuilder, Storage};
+
+/// (node, from, to) of one event.
+type NodeChange = (usize, fricont::Class, fricont::Class);
+
+fn run(data: &Data, a0: f64, a1: f64) -> Path {
+    trace(Arc::new(data.problem()), data.affine_load(), a0, a1)
+}
+
+fn close(a: f64, b: f64, tol: f64) -> bool {
+    (a - b).abs() <= tol * 1f64.max(a.abs()).max(b.abs())
+}
+
+/// `base` is a prefix of `other` (α to `tol` relative, same nodes, classes, flags).
+fn assert_prefix(ctx: &str, base: &[Event], other: &[Event], tol: f64) {
+    assert!(
+        other.len() >= base.len(),
+        "{ctx}: {} events, the original window has {}",
+        other.len(),
+        base.len()
+    );
+    for (x, y) in base.iter().zip(other) {
+        assert!(
+            close(x.alpha, y.alpha, tol),
+            "{ctx}: event {} at α {:.17e}, originally {:.17e}",
+            x.index + 1,
+            y.alpha,
+            x.alpha
+        );
+        assert_eq!(
+            (x.node, x.from, x.to, x.fold, x.transition),
+            (y.node, y.from, y.to, y.fold, y.transition),
+            "{ctx}: event {}",
+            x.index + 1
+        );
+    }
+}
+
+fn start_classes(p: &Path) -> Vec<fricont::Class> {
+    p.start_state().expect("started").classes.clone()
+}
+
+/// The repository's sample (n = 1320, p = 30), read with the tests' own reader.
+fn sample() -> (ProblemBuilder, Vec<f64>, Vec<f64>) {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/sample-rect30");
+    let csr = |name: &str| {
+        let (r, c, t) = read_mtx(&dir.join(name));
+        CsrMatrix::from_triplets(name, r, c, &t).unwrap()
+    };
+    let b = ProblemBuilder::new(csr("A.mtx"), Storage::Full, csr("N.mtx"), csr("T.mtx"))
+        .friction_uniform(0.3);
+    (
+        b,
+        read_vec(&dir.join("f0.txt")),
+        read_vec(&dir.join("f1.txt")),
+    )
+}
+
+#[test]
+fn far_window_ends_sample() {
+    let (b, f0, f1) = sample();
+    let problem = Arc::new(b.build().unwrap());
+    let load = || fricont::Load::affine(f0.clone(), f1.clone()).unwrap();
+    let base = trace(problem.clone(), load(), -0.5, 1.5);
+    assert!(base.events().len() >= 20);
+    for far in [1e3, 1e6, 1e9, 1e12] {
+        let mut opts = fricont::PathOptions::window(-0.5, far);
+        opts.max_steps = base.events().len() + 50;
+        let mut path = Path::new(problem.clone(), load(), opts).unwrap();
+        path.start(-0.5, None).unwrap();
+        // Stop once past the original window: what lies beyond is not compared.
+        while path.events().last().is_none_or(|e| e.alpha <= 1.5) {
+            if matches!(path.step().unwrap(), fricont::StepOutcome::End(_)) {
+                break;
+            }
+        }
+        let ctx = format!("sample, window [-0.5, {far:e}]");
+        assert_eq!(start_classes(&path), start_classes(&base), "{ctx}: start");
+        // 1e-10: the sample's shallow crossing (event 3) is determined to ~2e-11 only.
+        assert_prefix(&ctx, base.events(), path.events(), 1e-10);
+    }
+}
+
+#[test]
+fn far_window_ends_random() {
+    for seed in 0..120 {
+        let case = random_case(seed);
+        let base = run(&case.data, case.a0, case.a1);
+        let dir = (case.a1 - case.a0).signum();
+        for far in [1e3, 1e8, 1e12] {
+            let path = run(&case.data, case.a0, case.a0 + dir * far);
+            let ctx = format!("seed {seed}, far end {far:e}");
+            assert_eq!(start_classes(&path), start_classes(&base), "{ctx}: start");
+            assert_prefix(&ctx, base.events(), path.events(), 1e-11);
+        }
+    }
+}
+
+#[test]
+fn global_force_and_stiffness_scalings() {
+    for seed in 0..80 {
+        let case = random_case(seed);
+        let base = run(&case.data, case.a0, case.a1);
+        for s in [1e-9, 1e-3, 1e3, 1e9] {
+            let mut forces = case.data.clone();
+            forces.f0 *= s;
+            forces.f1 *= s;
+            forces.gap.iter_mut().for_each(|g| *g *= s);
+            let mut stiff = case.data.clone();
+            stiff.a *= s;
+            stiff.gap.iter_mut().for_each(|g| *g /= s);
+            for (kind, data, lam_factor) in [("forces", forces, s), ("stiffness", stiff, 1.0)] {
+                let ctx = format!("seed {seed}, {kind} × {s:e}");
+                let path = run(&data, case.a0, case.a1);
+                let (x, y) = (base.events(), path.events());
+                assert_eq!(x.len(), y.len(), "{ctx}");
+                assert_prefix(&ctx, x, y, 1e-11);
+                // λ relative to the largest force along the path (an event where every
+                // node is open has λ = 0 up to rounding).
+                let lam_scale = x
+                    .iter()
+                    .flat_map(|e| e.lambda_n.iter().chain(&e.lambda_t))
+                    .fold(1e-300f64, |m, v| m.max(v.abs()))
+                    .max(case.data.f0.amax() + case.data.f1.amax());
+                for (e, f) in x.iter().zip(y) {
+                    for (a, b) in e
+                        .lambda_n
+                        .iter()
+                        .chain(&e.lambda_t)
+                        .zip(f.lambda_n.iter().chain(&f.lambda_t))
+                    {
+                        assert!(
+                            (a * lam_factor - b).abs() <= 1e-9 * lam_scale * lam_factor,
+                            "{ctx}: λ {b:e}, expected {:e}",
+                            a * lam_factor
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn node_permutations() {
+    for seed in 0..80 {
+        let case = random_case(seed);
+        let data = &case.data;
+        let p = data.p;
+        let mut rng = Rng::new(seed + 777);
+        // perm[i] = new index of node i
+        let mut perm: Vec<usize> = (0..p).collect();
+        for i in (1..p).rev() {
+            let j = rng.int(0, i);
+            perm.swap(i, j);
+        }
+        let mut q = data.clone();
+        for (i, &pi) in perm.iter().enumerate() {
+            q.nm.set_row(pi, &data.nm.row(i));
+            q.tm.set_row(pi, &data.tm.row(i));
+            q.friction[pi] = data.friction[i];
+            q.gap[pi] = data.gap[i];
+        }
+        let base = run(data, case.a0, case.a1);
+        let path = run(&q, case.a0, case.a1);
+        let ctx = format!("seed {seed}, permutation {perm:?}");
+        let (x, y) = (base.events(), path.events());
+        assert_eq!(x.len(), y.len(), "{ctx}");
+        // Events of one transition are listed in node order: compare them as sets.
+        let group = |ev: &[Event], map: &dyn Fn(usize) -> usize| {
+            let mut g: Vec<(usize, f64, Vec<NodeChange>)> = Vec::new();
+            for e in ev {
+                if g.last().is_none_or(|l| l.0 != e.transition) {
+                    g.push((e.transition, e.alpha, Vec::new()));
+                }
+                g.last_mut().unwrap().2.push((map(e.node), e.from, e.to));
+            }
+            for t in &mut g {
+                t.2.sort_by_key(|k| k.0);
+            }
+            g
+        };
+        let gx = group(x, &|i| perm[i]);
+        let gy = group(y, &|i| i);
+        for (a, b) in gx.iter().zip(&gy) {
+            assert!(close(a.1, b.1, 1e-11), "{ctx}: α {} vs {}", a.1, b.1);
+            assert_eq!(a.2, b.2, "{ctx}");
+        }
+    }
+}

@@ -1,0 +1,169 @@
+//! Updated factorisations against fresh ones: on every test family (random brute-force
+//! problems, finite-element meshes, symmetric bodies, folds, vertical pieces, a sample
+//! mesh, nonlinear loads) the path traced by rank-2 updates of one factorised base must
+//! be the path traced by a fresh full-pivoting factorisation of every piece Jacobian: the
+//! same events (α to 1e-12 relative, nodes, classes, fold and bifurcation flags), and on
+//! every piece the same direction, orientation and determinant sign — the signs the
+//! updated tracer carries by the matrix determinant lemma, the fresh one reads off the
+//! pivots.
+
+mod common;
+
+use std::sync::Arc;
+
+use common::{
+    Case, Data, fe_case, fold_problem, mirror_pair, random_case, symmetric_case, vertical_problem,
+};
+use fricont::load::{Load, LoadFailure};
+use fricont::path::{Path, PathOptions};
+use fricont::problem::Problem;
+
+fn run(problem: &Arc<Problem>, load: Load, a0: f64, a1: f64, fresh: bool) -> Path {
+    let mut opts = PathOptions::window(a0, a1);
+    opts.fresh_factorisations = fresh;
+    let mut path = Path::new(problem.clone(), load, opts).expect("Path::new");
+    path.start(a0, None).expect("start");
+    path.run().expect("run");
+    path
+}
+
+/// Compares the two tracers; returns the number of events compared.
+fn compare(ctx: &str, problem: Arc<Problem>, load: impl Fn() -> Load, a0: f64, a1: f64) -> usize {
+    let up = run(&problem, load(), a0, a1, false);
+    let fr = run(&problem, load(), a0, a1, true);
+    let (eu, ef) = (up.events(), fr.events());
+    assert_eq!(eu.len(), ef.len(), "{ctx}: number of events");
+    for (x, y) in eu.iter().zip(ef) {
+        let tol = 1e-12 * 1f64.max(x.alpha.abs());
+        assert!(
+            (x.alpha - y.alpha).abs() <= tol,
+            "{ctx}: event {} at α {:.17e} (updated) vs {:.17e} (fresh)",
+            x.index + 1,
+            x.alpha,
+            y.alpha
+        );
+        assert_eq!(
+            (x.node, x.from, x.to, x.fold, x.bifurcation, x.transition),
+            (y.node, y.from, y.to, y.fold, y.bifurcation, y.transition),
+            "{ctx}: event {}",
+            x.index + 1
+        );
+    }
+    let (pu, pf) = (up.pieces(), fr.pieces());
+    assert_eq!(pu.len(), pf.len(), "{ctx}: number of pieces");
+    for (k, (x, y)) in pu.iter().zip(pf).enumerate() {
+        assert_eq!(x.classes, y.classes, "{ctx}: piece {k}");
+        assert_eq!(
+            (x.direction, x.orientation, x.det_sign),
+            (y.direction, y.orientation, y.det_sign),
+            "{ctx}: piece {k} (direction, orientation, det sign)"
+        );
+    }
+    assert_eq!(up.end_reason(), fr.end_reason(), "{ctx}: end reason");
+    eu.len()
+}
+
+fn compare_case(ctx: &str, case: &Case) -> usize {
+    let data = &case.data;
+    compare(
+        ctx,
+        Arc::new(data.problem()),
+        || data.affine_load(),
+        case.a0,
+        case.a1,
+    )
+}
+
+#[test]
+fn random_problems() {
+    let mut events = 0;
+    for seed in 0..200 {
+        events += compare_case(&format!("random seed {seed}"), &random_case(seed));
+    }
+    assert!(events > 400, "only {events} events compared");
+}
+
+#[test]
+fn finite_element_meshes() {
+    let mut events = 0;
+    for seed in 0..40u64 {
+        let nx = 3 + (seed % 4) as usize;
+        let ny = 1 + ((seed / 4) % 3) as usize;
+        let friction = [0.3, 1.0, 3.0, 5.0][((seed / 12) % 4) as usize];
+        let case = fe_case(seed, nx, ny, friction);
+        events += compare_case(
+            &format!("FE seed {seed} ({nx}x{ny}, F = {friction})"),
+            &case,
+        );
+    }
+    assert!(events > 100, "only {events} events compared");
+}
+
+#[test]
+fn symmetric_bodies() {
+    for seed in 0..40 {
+        let centre = seed % 2 == 1;
+        compare_case(
+            &format!("symmetric seed {seed}"),
+            &symmetric_case(seed, centre),
+        );
+    }
+}
+
+#[test]
+fn folds_vertical_pieces_and_mirror_pairs() {
+    for (name, data, a0, a1) in [
+        ("fold problem", fold_problem(), -3.0, 3.0),
+        ("vertical problem", vertical_problem(), -2.0, 2.0),
+        ("mirror pair", mirror_pair(), -2.0, 2.0),
+    ] {
+        compare(
+            name,
+            Arc::new(data.problem()),
+            || data.affine_load(),
+            a0,
+            a1,
+        );
+    }
+}
+
+/// A mesh with many more transitions than updates kept on one base, so that the base is
+/// refactorised several times along the path, and the nonlinear-load stepping (which
+/// solves with the updated factorisation) on the same mesh.
+#[test]
+fn long_paths_refactorise_and_nonlinear_loads() {
+    let case = fe_case(7, 24, 2, 1.0);
+    let data: &Data = &case.data;
+    let problem = Arc::new(data.problem());
+    let n = compare(
+        "FE 24x2",
+        problem.clone(),
+        || data.affine_load(),
+        case.a0,
+        case.a1,
+    );
+    let up = run(&problem, data.affine_load(), case.a0, case.a1, false);
+    let m = 2 * data.p;
+    assert!(
+        n > m / 8 && up.refactorisations() >= 2 && up.refactorisations() < n,
+        "{n} events, {} refactorisations: the updates were not exercised",
+        up.refactorisations()
+    );
+    let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
+    let basis = || {
+        Load::basis(
+            vec![f0.clone(), f1.clone()],
+            Box::new(
+                |a: f64, w: &mut [f64], dw: &mut [f64]| -> Result<(), LoadFailure> {
+                    w[0] = 1.0;
+                    w[1] = a + 0.1 * a * a * a;
+                    dw[0] = 0.0;
+                    dw[1] = 1.0 + 0.3 * a * a;
+                    Ok(())
+                },
+            ),
+        )
+        .unwrap()
+    };
+    compare("FE 24x2, cubic load", problem, basis, case.a0, case.a1);
+}
