@@ -189,11 +189,11 @@ impl BoundLoad {
         })
     }
 
-    /// The magnitude of the terms that make up `q(α)`: `max_k Σ_j |w_j(α)| |q_j,k|`
+    /// The magnitude of the terms that make up each row of `q(α)`: `Σ_j |w_j(α)| |q_j,k|`
     /// (affine: `w = (1, α)`; basis: the weights last evaluated, if at this α). Rounding
-    /// errors in `q(α)` are proportional to it, not to `|q(α)|`, which can cancel to zero.
-    /// `None` for a general load (or basis weights not evaluated at α).
-    pub(crate) fn term_magnitude(&self, alpha: f64) -> Option<f64> {
+    /// errors in `q_k(α)` are proportional to it, not to `|q_k(α)|`, which can cancel to
+    /// zero. `None` for a general load (or basis weights not evaluated at α).
+    pub(crate) fn term_magnitude_rows(&self, alpha: f64) -> Option<Vec<f64>> {
         let w: Vec<f64> = match &self.load {
             Load::Affine { .. } => vec![1.0, alpha.abs()],
             Load::Basis { .. } if self.weights_alpha == alpha => {
@@ -202,16 +202,16 @@ impl BoundLoad {
             _ => return None,
         };
         let m = self.q_basis.first()?.len();
-        let mut mag = 0.0f64;
-        for k in 0..m {
-            let t: f64 = w
-                .iter()
-                .zip(&self.q_basis)
-                .map(|(wj, qj)| wj * qj[k].abs())
-                .sum();
-            mag = mag.max(t);
-        }
-        Some(mag)
+        Some(
+            (0..m)
+                .map(|k| {
+                    w.iter()
+                        .zip(&self.q_basis)
+                        .map(|(wj, qj)| wj * qj[k].abs())
+                        .sum()
+                })
+                .collect(),
+        )
     }
 
     /// True when `f` (hence `q`) is affine in α.

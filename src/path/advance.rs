@@ -61,8 +61,7 @@ impl Path {
     pub(super) fn exit_linear(&mut self, cur: &CurrentPiece) -> Result<Exit> {
         let m = 2 * self.problem.p();
         let pt = self.point_at(cur.lam.clone(), cur.alpha)?;
-        let scale = self.force_scale(&pt);
-        let tol = self.opts.zero_tol * scale;
+        let tol = self.tol_at(&pt);
         let table = self.guard_table(&cur.classes, &pt, Some(&cur.t));
         let mut best: Option<(f64, Guard)> = None;
         for &GuardRow {
@@ -71,7 +70,7 @@ impl Path {
             slope: vd,
         } in &table
         {
-            if vd < -tol {
+            if vd < -tol.slope() {
                 let s = (v / -vd).max(0.0);
                 if best.is_none_or(|b| s < b.0) {
                     best = Some((s, g));
@@ -206,15 +205,20 @@ impl Path {
         let mut h = (span / 32.0).min((bound - cur.alpha).abs());
         let hmin = span * 1e-12;
         loop {
-            let scale = self.force_scale(&pa);
-            let tol = self.opts.zero_tol * scale;
+            let tol_at = self.tol_at(&pa);
+            let tol: Vec<f64> = {
+                let c = self.consts();
+                ga.iter()
+                    .map(|row| tol_at.of(&c.guard_form(row.guard)))
+                    .collect()
+            };
             let at_bound = (bound - pa.alpha).abs() <= h;
             let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
             let (mut pb, mut gb) = eval(self, b_alpha)?;
             // A guard the piece just entered (zero at a, increasing) that is negative at b:
             // the step overshoots the piece's first stretch; shorten it.
             let premature = (0..gb.len())
-                .any(|k| ga[k].value <= tol && dir * ga[k].slope > 0.0 && gb[k].value < -tol);
+                .any(|k| ga[k].value <= tol[k] && dir * ga[k].slope > 0.0 && gb[k].value < -tol[k]);
             if premature && h > hmin {
                 h *= 0.5;
                 continue;
@@ -225,8 +229,8 @@ impl Path {
             // is never skipped, however close to tangent.
             let mut cut: Option<f64> = None;
             for k in 0..gb.len() {
-                if ga[k].value > -tol
-                    && gb[k].value >= -tol
+                if ga[k].value > -tol[k]
+                    && gb[k].value >= -tol[k]
                     && dir * ga[k].slope < 0.0
                     && dir * gb[k].slope > 0.0
                 {
@@ -248,7 +252,7 @@ impl Path {
                         return Err(e);
                     }
                     let (_, tab) = eval(self, smin)?;
-                    if tab[k].value < -tol && cut.is_none_or(|c| dir * (smin - c) < 0.0) {
+                    if tab[k].value < -tol[k] && cut.is_none_or(|c| dir * (smin - c) < 0.0) {
                         cut = Some(smin);
                     }
                 }
@@ -258,13 +262,13 @@ impl Path {
             }
             let at_bound = at_bound && cut.is_none();
             let delta = pb.alpha - pa.alpha;
-            let crossing: Vec<usize> = (0..gb.len()).filter(|&k| gb[k].value < -tol).collect();
+            let crossing: Vec<usize> = (0..gb.len()).filter(|&k| gb[k].value < -tol[k]).collect();
             if crossing.is_empty() {
                 // Hermite check for a dip below zero inside the step
                 let dip = (0..gb.len()).any(|k| {
                     let (v0, v1) = (ga[k].value, gb[k].value);
                     let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
-                    hermite_min(v0, v1, m0, m1) < -tol
+                    hermite_min(v0, v1, m0, m1) < -tol[k]
                 });
                 if dip && h > hmin {
                     h *= 0.5;

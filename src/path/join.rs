@@ -8,7 +8,7 @@ use super::*;
 impl Path {
     /// Classes of each node in `nodes` whose equations and guards hold at the point (to
     /// `tol`, in force units). One product with W for all of them.
-    pub(super) fn compatible(&self, nodes: &[usize], pt: &Point, tol: f64) -> Vec<Vec<Class>> {
+    pub(super) fn compatible(&self, nodes: &[usize], pt: &Point, tol: &Tol) -> Vec<Vec<Class>> {
         let d = self.gaps(pt);
         nodes
             .iter()
@@ -17,7 +17,7 @@ impl Path {
     }
 
     /// Classes of node `i` compatible with `(λ, d)` (to `tol`, in force units).
-    pub(super) fn compatible_at(&self, i: usize, lam: &[f64], d: &[f64], tol: f64) -> Vec<Class> {
+    pub(super) fn compatible_at(&self, i: usize, lam: &[f64], d: &[f64], tol: &Tol) -> Vec<Class> {
         let c = self.consts();
         let r0 = c.r0;
         Class::ALL
@@ -33,12 +33,13 @@ impl Path {
                         } else {
                             0.0
                         };
-                    v.abs() <= tol
+                    v.abs() <= tol.of(e)
                 });
                 eq_ok
-                    && crate::piece::guard_kinds(cl)
-                        .iter()
-                        .all(|&kind| c.guard_form(Guard { node: i, kind }).eval(lam, d) >= -tol)
+                    && crate::piece::guard_kinds(cl).iter().all(|&kind| {
+                        let f = c.guard_form(Guard { node: i, kind });
+                        f.eval(lam, d) >= -tol.of(&f)
+                    })
             })
             .collect()
     }
@@ -50,7 +51,7 @@ impl Path {
         classes: &[Class],
         pt: &Point,
         scale: f64,
-        tol: f64,
+        tol: &Tol,
         back: Option<(&[Class], &[f64])>,
         relaxed: bool,
         out: &mut Vec<Candidate>,
@@ -79,16 +80,20 @@ impl Path {
             }) {
                 continue;
             }
+            let c = self.consts();
             let enters = table.iter().all(|row| {
                 let (v, vd) = (row.value, s * row.slope);
-                if v > tol {
+                // Values against the guard's own threshold; slopes (force per unit of
+                // scaled arclength) against the scale of the point.
+                let (tv, ts) = (tol.of(&c.guard_form(row.guard)), tol.slope());
+                if v > tv {
                     true
-                } else if v < -tol {
+                } else if v < -tv {
                     false
                 } else if relaxed {
-                    vd >= -tol
+                    vd >= -ts
                 } else {
-                    vd > tol
+                    vd > ts
                 }
             });
             if enters {
@@ -132,8 +137,8 @@ impl Path {
         relaxed: bool,
     ) -> Result<Vec<Candidate>> {
         let scale = self.force_scale(pt);
-        let tol = self.opts.zero_tol * scale;
-        let options: Vec<Vec<Class>> = self.compatible(nodes, pt, tol);
+        let tol = self.tol_at(pt);
+        let options: Vec<Vec<Class>> = self.compatible(nodes, pt, &tol);
         if let Some(k) = options.iter().position(|o| o.is_empty()) {
             return Err(Error::Numerical(format!(
                 "node {} fits no class at alpha = {:e} (the point is not a solution)",
@@ -176,11 +181,11 @@ impl Path {
                     .collect();
                 for s in [1.0, -1.0] {
                     if let Some(cl) = self.directional_classes(pt, &frozen, s) {
-                        self.push_candidates(&cl, pt, scale, tol, back, relaxed, &mut out);
+                        self.push_candidates(&cl, pt, scale, &tol, back, relaxed, &mut out);
                     }
                 }
             } else {
-                self.push_candidates(&classes, pt, scale, tol, back, relaxed, &mut out);
+                self.push_candidates(&classes, pt, scale, &tol, back, relaxed, &mut out);
             }
             // next combination
             let mut k = 0;
@@ -213,13 +218,13 @@ impl Path {
         let d = displacement_gaps(w, &qdir, &lam);
         let r0 = self.problem.default_r();
         let sc = inf_norm(&lam).max(r0 * inf_norm(&qdir)).max(1e-300);
-        let tol = self.opts.zero_tol * sc;
+        let tol = Tol::uniform(self.opts.zero_tol * sc);
         let mut classes = Vec::with_capacity(frozen.len());
         for (i, f) in frozen.iter().enumerate() {
             match f {
                 Some(c) => classes.push(*c),
                 None => {
-                    let comp = self.compatible_at(i, &lam, &d, tol);
+                    let comp = self.compatible_at(i, &lam, &d, &tol);
                     if comp.len() != 1 {
                         return None;
                     }
@@ -238,20 +243,20 @@ impl Path {
         pt: Point,
         crossing: Vec<Guard>,
     ) -> Result<StepOutcome> {
-        let scale = self.force_scale(&pt);
-        let tol = self.opts.zero_tol * scale;
+        let tol = self.tol_at(&pt);
+        let c = self.consts();
         let mut nodes: Vec<usize> = crossing.iter().map(|g| g.node).collect();
         for GuardRow {
             guard: g, value: v, ..
         } in self.guard_table(&cur.classes, &pt, None)
         {
-            if v <= tol {
+            if v <= tol.of(&c.guard_form(g)) {
                 nodes.push(g.node);
             }
         }
         nodes.sort_unstable();
         nodes.dedup();
-        let pt = self.snap_to_vertex(pt, tol)?;
+        let pt = self.snap_to_vertex(pt, &tol)?;
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
         let mut cands = self.continuations(&pt, &cur.classes, &nodes, back, false)?;
         if cands.is_empty() {
@@ -328,9 +333,9 @@ impl Path {
     /// guard carries that guard's rounding; the exact point is `λ = 0` at the α that
     /// minimises `‖q(α) − (g, 0)‖` (closed form for an affine load). Other points are
     /// returned unchanged.
-    pub(super) fn snap_to_vertex(&mut self, pt: Point, tol: f64) -> Result<Point> {
+    pub(super) fn snap_to_vertex(&mut self, pt: Point, tol: &Tol) -> Result<Point> {
         let p = self.problem.p();
-        if inf_norm(&pt.lam) > tol
+        if inf_norm(&pt.lam) > tol.disp
             || self
                 .compatible(&(0..p).collect::<Vec<_>>(), &pt, tol)
                 .iter()
@@ -355,7 +360,7 @@ impl Path {
         };
         let snapped = self.point_at(vec![0.0; m], alpha)?;
         let qg = shift_gap(&snapped.q, self.problem.gap());
-        if self.problem.default_r() * inf_norm(&qg) <= tol {
+        if self.problem.default_r() * inf_norm(&qg) <= tol.disp {
             Ok(snapped)
         } else {
             Ok(pt)

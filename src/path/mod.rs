@@ -40,8 +40,10 @@ pub struct PathOptions {
     /// [`EndReason::MaxSteps`] (default 10 000).
     pub max_steps: usize,
     /// Relative tolerance for "a guard is at zero" and "two nodes switch at once"
-    /// (default 1e-11, relative to the force scale of the current point; displacement
-    /// guards are compared after multiplication by [`Problem::default_r`]).
+    /// (default 1e-11). It is relative to local scales of the current point, never to
+    /// the window: a force guard to the contact forces there, a displacement guard
+    /// (compared after multiplication by [`Problem::default_r`]) to the magnitude of the
+    /// terms of its own row of `q + W λ − (g, 0)`.
     pub zero_tol: f64,
     /// Factorise every piece matrix afresh (O(m³) per piece, m = 2p) instead of updating
     /// one factorised base by rank-2 changes (O(m²) per piece; default `false`). The
@@ -220,6 +222,8 @@ pub struct Path {
     /// The last `d = q − (g, 0) + W λ` with its (α, λ): every candidate piece at a
     /// transition point needs it.
     gaps_cache: RefCell<Option<GapsAt>>,
+    /// `|W|` entry by entry (for the rounding scale of `W λ`), made on first use.
+    abs_w: RefCell<Option<Arc<faer::Mat<f64>>>>,
 }
 
 /// The traced data and the current position.
@@ -243,6 +247,43 @@ struct Trace {
     /// The last transition, kept while a branch may still be chosen there.
     pending: Option<PendingJoin>,
     branches: Vec<Branch>,
+}
+
+/// "At zero" thresholds at a point, in force units: `force` for a form in λ only (per
+/// unit of its coefficients); for a form with a displacement term `d_k`, `rows[k]`, the
+/// threshold of that row of `d = q − (g, 0) + W λ` (relative to the magnitude of the
+/// terms that make it up); `disp` is the largest of them.
+#[derive(Clone, Debug)]
+pub(super) struct Tol {
+    force: f64,
+    disp: f64,
+    rows: Option<Arc<Vec<f64>>>,
+}
+
+impl Tol {
+    /// One threshold for every form.
+    fn uniform(t: f64) -> Self {
+        Tol {
+            force: t,
+            disp: t,
+            rows: None,
+        }
+    }
+
+    /// The threshold for the derivative of a form along a unit tangent (scaled
+    /// coordinates): relative to the point's force scale.
+    fn slope(&self) -> f64 {
+        self.disp
+    }
+
+    /// The threshold for a linear form.
+    fn of(&self, f: &crate::piece::LinForm) -> f64 {
+        if f.disp.coef != 0.0 {
+            self.rows.as_ref().map_or(self.disp, |r| r[f.disp.index])
+        } else {
+            self.force * (f.lam[0].coef.abs() + f.lam[1].coef.abs()).max(1.0)
+        }
+    }
 }
 
 /// `d` at a point `(α, λ)`.
@@ -420,6 +461,7 @@ impl Path {
             refactorisations: Cell::new(0),
             row_bound: Cell::new(None),
             gaps_cache: RefCell::new(None),
+            abs_w: RefCell::new(None),
         })
     }
 
@@ -451,21 +493,74 @@ impl Path {
         Ok(Point { lam, alpha, q, dq })
     }
 
-    /// Force scale of a point, from the point alone (never from the window):
-    /// `max(‖λ‖∞, r0 ‖q − (g, 0)‖∞, r0 (T + ‖g‖∞))` with T the magnitude of the terms that
-    /// make up q(α) (see [`BoundLoad::term_magnitude`]): where the load passes through zero
-    /// the rounding of q is still proportional to T.
+    /// Force scale of a point: `max(‖λ‖∞, r0 ‖q − (g, 0)‖∞, r0 (T + ‖g‖∞))` with T the
+    /// magnitude of the terms that make up q(α) (see [`Self::term_rows`]): where the load
+    /// passes through zero the rounding of q is still proportional to T. For affine and
+    /// basis loads it depends on the point alone, never on the window.
     fn force_scale(&self, pt: &Point) -> f64 {
         let r0 = self.problem.default_r();
         let qg = shift_gap(&pt.q, self.problem.gap());
-        let terms = self
-            .load
-            .term_magnitude(pt.alpha)
-            .map_or(0.0, |t| t + inf_norm(self.problem.gap()));
+        let terms =
+            self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b)) + inf_norm(self.problem.gap());
         inf_norm(&pt.lam)
             .max(r0 * inf_norm(&qg))
             .max(r0 * terms)
             .max(1e-300)
+    }
+
+    /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
+    /// ([`BoundLoad::term_magnitude_rows`]); for a general load, whose terms are not
+    /// known, `|q_k| + |α_end − α_start| |q'_k|` (the change of q over the window).
+    fn term_rows(&self, pt: &Point) -> Vec<f64> {
+        self.load.term_magnitude_rows(pt.alpha).unwrap_or_else(|| {
+            let span = self.alpha_scale();
+            pt.q.iter()
+                .zip(&pt.dq)
+                .map(|(q, dq)| q.abs() + span * dq.abs())
+                .collect()
+        })
+    }
+
+    /// The "at zero" thresholds at a point. A row `d_k` of the displacement gaps is at
+    /// zero below `zero_tol · r0 (|q_k|ₜ + |g_k| + (|W| |λ|)_k)` (but not below 1e-3 of the
+    /// point's threshold: the rows of q come from solves with A), with `|q_k|ₜ` the
+    /// magnitude of the terms of `q_k(α)` (see [`BoundLoad::term_magnitude`]): what its
+    /// rounding is proportional to, row by row (on slender bodies the rows of q differ by
+    /// orders of magnitude). A force form is at zero below `zero_tol` times the contact
+    /// forces, `max(‖λ‖∞, force scale / 10)` (the floor keeps the rounding of λ, which is
+    /// relative to the load, below it where all forces vanish together).
+    fn tol_at(&self, pt: &Point) -> Tol {
+        // The rows of q come from solves with A, whose rounding is relative to the whole
+        // vector: no row's threshold goes below 1e-3 of the point's.
+        const ROW_FLOOR: f64 = 1e-3;
+        let scale = self.force_scale(pt);
+        let z = self.opts.zero_tol;
+        let r0 = self.problem.default_r();
+        let w = self.problem.delassus().w();
+        let m = pt.lam.len();
+        let abs_lam: Vec<f64> = pt.lam.iter().map(|v| v.abs()).collect();
+        let abs_w = self
+            .abs_w
+            .borrow_mut()
+            .get_or_insert_with(|| {
+                Arc::new(faer::Mat::<f64>::from_fn(m, m, |i, j| w[(i, j)].abs()))
+            })
+            .clone();
+        let wl = displacement_gaps(abs_w.as_ref().as_ref(), &vec![0.0; m], &abs_lam);
+        let qt = self.term_rows(pt);
+        let gap = self.problem.gap();
+        let p = self.problem.p();
+        let rows: Vec<f64> = (0..m)
+            .map(|k| {
+                let g = if k < p { gap[k].abs() } else { 0.0 };
+                (z * r0 * (qt[k] + g + wl[k])).max(ROW_FLOOR * z * scale)
+            })
+            .collect();
+        Tol {
+            force: z * inf_norm(&pt.lam).max(0.1 * scale),
+            disp: z * scale,
+            rows: Some(Arc::new(rows)),
+        }
     }
 
     /// The unit of α at a point: the change of α that moves the load by the force scale,
@@ -692,11 +787,11 @@ impl Path {
         let qg = shift_gap(&pt.q, self.problem.gap());
         let lam = solve_fixed_alpha(&self.problem, &qg, guess, alpha)?;
         let pt = Point { lam, ..pt };
-        let tol = self.opts.zero_tol * self.force_scale(&pt);
+        let tol = self.tol_at(&pt);
         let p = self.problem.p();
         let mut fixed = vec![Class::Open; p];
         let mut nodes = Vec::new();
-        let all = self.compatible(&(0..p).collect::<Vec<_>>(), &pt, tol);
+        let all = self.compatible(&(0..p).collect::<Vec<_>>(), &pt, &tol);
         for (i, comp) in all.into_iter().enumerate() {
             match comp.len() {
                 0 => {
