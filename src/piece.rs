@@ -491,7 +491,7 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
         }
     }
     for i in 0..p {
-        let g = problem.gap()[i];
+        let g = problem.gap_equilibrated()[i];
         let (ln, lt) = (lam[i], lam[p + i]);
         let h2 = ln - (ln - r * (bu[i] - g)).min(0.0);
         let b = (-problem.friction()[i] * ln).max(0.0);

@@ -442,12 +442,25 @@ impl ProblemBuilder {
             )));
         }
         let (lower, full_a) = lower_and_full(&self.a, self.storage)?;
-        // B = [N; T] as one CSR matrix (2p x n).
+        // Equilibration: node i's rows N_i, T_i and gap g_i divided by
+        // s_i = max(‖N_i‖₂, ‖T_i‖₂). The problem is invariant under such a per-node
+        // scaling (λ_i scales by s_i), and with unit rows no node's forces are measured on
+        // another node's scale.
+        let row_norm = |m: &CsrMatrix, i: usize| m.row(i).map(|(_, v)| v * v).sum::<f64>().sqrt();
+        let node_scale: Vec<f64> = (0..p)
+            .map(|i| {
+                let s = row_norm(&self.n, i).max(row_norm(&self.t, i));
+                if s.is_finite() && s > 0.0 { s } else { 1.0 }
+            })
+            .collect();
+        // B = [N; T] as one CSR matrix (2p x n), equilibrated.
         let mut trip = Vec::with_capacity(self.n.nnz() + self.t.nnz());
         for i in 0..p {
-            trip.extend(self.n.row(i).map(|(j, v)| (i, j, v)));
-            trip.extend(self.t.row(i).map(|(j, v)| (p + i, j, v)));
+            let s = node_scale[i];
+            trip.extend(self.n.row(i).map(|(j, v)| (i, j, v / s)));
+            trip.extend(self.t.row(i).map(|(j, v)| (p + i, j, v / s)));
         }
+        let gap_eq: Vec<f64> = gap.iter().zip(&node_scale).map(|(g, s)| g / s).collect();
         let b = CsrMatrix::from_triplets("B", 2 * p, n, &trip)?;
         let delassus = std::sync::Arc::new(Delassus::new(&lower, &b)?);
         let r_default = delassus.default_r();
@@ -459,6 +472,8 @@ impl ProblemBuilder {
             b,
             friction,
             gap,
+            gap_eq,
+            node_scale,
             r,
             r_default,
             delassus,
@@ -607,7 +622,11 @@ pub struct Problem {
     a: CsrMatrix,
     b: CsrMatrix,
     friction: Vec<f64>,
+    /// The gap as given.
     gap: Vec<f64>,
+    /// Equilibrated gap `g_i / s_i`.
+    gap_eq: Vec<f64>,
+    node_scale: Vec<f64>,
     r: f64,
     r_default: f64,
     delassus: std::sync::Arc<Delassus>,
@@ -626,17 +645,28 @@ impl Problem {
     pub fn a(&self) -> &CsrMatrix {
         &self.a
     }
-    /// `B = [N; T]` (2p×n): rows `0..p` are N, rows `p..2p` are T.
+    /// The equilibrated `B = [N; T]` (2p×n): rows `0..p` are N, rows `p..2p` are T, node
+    /// i's two rows divided by [`Problem::node_scale`]`[i]`. W, the condensed loads and
+    /// every internal λ refer to these rows; the path reports λ in the caller's units.
     pub fn b(&self) -> &CsrMatrix {
         &self.b
+    }
+    /// The scale `s_i = max(‖N_i‖₂, ‖T_i‖₂)` of each node's rows (1 for an empty row).
+    /// Internal forces are `s_i λ_i` for the caller's `λ_i`.
+    pub fn node_scale(&self) -> &[f64] {
+        &self.node_scale
     }
     /// Friction coefficients, one per node.
     pub fn friction(&self) -> &[f64] {
         &self.friction
     }
-    /// Gap, one per node.
+    /// Gap, one per node, as given (length units of `N u`).
     pub fn gap(&self) -> &[f64] {
         &self.gap
+    }
+    /// The equilibrated gap `g_i / s_i` (see [`Problem::b`]).
+    pub fn gap_equilibrated(&self) -> &[f64] {
+        &self.gap_eq
     }
     /// The augmentation parameter in use (force per length).
     pub fn r(&self) -> f64 {
@@ -667,6 +697,8 @@ impl Problem {
             b: self.b.clone(),
             friction: self.friction.clone(),
             gap: self.gap.clone(),
+            gap_eq: self.gap_eq.clone(),
+            node_scale: self.node_scale.clone(),
             r,
             r_default: self.r_default,
             delassus: self.delassus.clone(),

@@ -69,11 +69,17 @@ fn wide_rows_fall_back_to_solves_and_match_a_dense_reference() {
     .build()
     .unwrap();
     let am = DMatrix::from_row_slice(nd, nd, &a);
+    // The library equilibrates each node's rows by max(‖N_i‖₂, ‖T_i‖₂): so does the
+    // reference, from the rows themselves.
+    let norm = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt();
     let mut b = DMatrix::zeros(2 * p, nd);
     for i in 0..p {
+        let (nr, tr) = (&nrows[i * nd..(i + 1) * nd], &trows[i * nd..(i + 1) * nd]);
+        let s = norm(nr).max(norm(tr));
+        assert_eq!(pb.node_scale()[i], s);
         for j in 0..nd {
-            b[(i, j)] = nrows[i * nd + j];
-            b[(p + i, j)] = trows[i * nd + j];
+            b[(i, j)] = nr[j] / s;
+            b[(p + i, j)] = tr[j] / s;
         }
     }
     let w_ref = &b * am.lu().solve(&b.transpose()).unwrap();

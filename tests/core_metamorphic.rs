@@ -205,3 +205,57 @@ fn node_permutations() {
         }
     }
 }
+
+/// Per-node scaling: multiplying node i's rows N_i, T_i and gap g_i by c_i > 0 (spread
+/// over 1e-6 … 1e6) is the same problem with λ_i divided by c_i.
+#[test]
+fn per_node_row_scalings() {
+    let mut cases: Vec<common::Case> = (0..60).map(random_case).collect();
+    cases.extend((0..12).map(|s| {
+        common::fe_case(
+            s,
+            4 + (s % 3) as usize,
+            2,
+            [0.3, 1.0, 5.0][(s % 3) as usize],
+        )
+    }));
+    for (k, case) in cases.iter().enumerate() {
+        let data = &case.data;
+        let p = data.p;
+        let mut rng = Rng::new(k as u64 + 4242);
+        let c: Vec<f64> = (0..p).map(|_| 10f64.powf(rng.range(-6.0, 6.0))).collect();
+        let mut q = data.clone();
+        for (i, &ci) in c.iter().enumerate() {
+            q.nm.row_mut(i).scale_mut(ci);
+            q.tm.row_mut(i).scale_mut(ci);
+            q.gap[i] *= ci;
+        }
+        let base = run(data, case.a0, case.a1);
+        let path = run(&q, case.a0, case.a1);
+        let ctx = format!("case {k} (seed {}), factors {c:?}", case.seed);
+        let (x, y) = (base.events(), path.events());
+        assert_eq!(x.len(), y.len(), "{ctx}");
+        assert_prefix(&ctx, x, y, 1e-10);
+        // Each node's forces to 1e-8 of its own size, plus 1e-12 of the largest force
+        // or load (a node at zero force carries rounding).
+        let global = x
+            .iter()
+            .flat_map(|e| e.lambda_n.iter().chain(&e.lambda_t))
+            .fold(data.f0.amax() + data.f1.amax(), |m, v| m.max(v.abs()));
+        for (e, f) in x.iter().zip(y) {
+            for (i, &ci) in c.iter().enumerate() {
+                let own = e.lambda_n[i].abs().max(e.lambda_t[i].abs());
+                for (a, b) in [
+                    (e.lambda_n[i], f.lambda_n[i]),
+                    (e.lambda_t[i], f.lambda_t[i]),
+                ] {
+                    assert!(
+                        (a - b * ci).abs() <= 1e-8 * own + 1e-12 * global,
+                        "{ctx}: node {i}: λ {b:e} × c = {:e}, expected {a:e}",
+                        b * ci
+                    );
+                }
+            }
+        }
+    }
+}

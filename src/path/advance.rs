@@ -97,7 +97,7 @@ impl Path {
             (b, Some(sw)) if b.is_none_or(|b| sw <= b.0) => {
                 let alpha = if ta > 0.0 { hi } else { lo };
                 let pt = self.point_at(vec![0.0; m], alpha)?;
-                let qg = shift_gap(&pt.q, self.problem.gap());
+                let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
                 let mlu = DenseLu::new(c.piece_matrix(w, &cur.classes).as_ref());
                 let lam = mlu.solve(&c.piece_rhs(&cur.classes, &qg));
                 Ok(Exit::Window(Point { lam, ..pt }))
@@ -107,7 +107,7 @@ impl Path {
                     // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
                     // piece's factorisation) and τ from the guard's equation; no drift
                     // from earlier points enters.
-                    let qg = shift_gap(&pt.q, self.problem.gap());
+                    let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
                     let (_, rhs) = c.jacobian(w, &cur.classes, &qg, &pt.dq, pt.alpha);
                     let form = c.guard_form(g);
                     let mut row = vec![0.0; m + 1];
@@ -192,7 +192,7 @@ impl Path {
         let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<GuardRow>)> {
             let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
             let c = this.consts();
-            let qg = shift_gap(&q, this.problem.gap());
+            let qg = shift_gap(&q, this.problem.gap_equilibrated());
             let lam = msolve(this, &c.piece_rhs(&classes, &qg));
             let dl = msolve(this, &c.piece_rhs(&classes, &dq));
             let mut t = dl;

@@ -345,7 +345,7 @@ impl Path {
         }
         let m = 2 * p;
         let alpha = if self.load.is_affine() {
-            let qg = shift_gap(&pt.q, self.problem.gap());
+            let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
             let (num, den) = qg
                 .iter()
                 .zip(&pt.dq)
@@ -359,7 +359,7 @@ impl Path {
             pt.alpha
         };
         let snapped = self.point_at(vec![0.0; m], alpha)?;
-        let qg = shift_gap(&snapped.q, self.problem.gap());
+        let qg = shift_gap(&snapped.q, self.problem.gap_equilibrated());
         if self.problem.default_r() * inf_norm(&qg) <= tol.disp {
             Ok(snapped)
         } else {
@@ -383,6 +383,7 @@ impl Path {
         let a_s = cand.scales.alpha;
         let p = self.problem.p();
         let snapshot = self.load.snapshot(pt.alpha)?;
+        let user = self.lam_to_user(&pt.lam);
         let tr = self.trace.as_mut().expect("started");
         tr.events.truncate(pend.events_start);
         tr.event_loads.truncate(pend.events_start);
@@ -400,8 +401,8 @@ impl Path {
                     to: cand.classes[i],
                     fold,
                     bifurcation: pend.bifurcation,
-                    lambda_n: pt.lam[..p].to_vec(),
-                    lambda_t: pt.lam[p..].to_vec(),
+                    lambda_n: user[..p].to_vec(),
+                    lambda_t: user[p..].to_vec(),
                     classes: cand.classes.clone(),
                 });
                 tr.event_loads.push(snapshot.clone());
@@ -411,8 +412,8 @@ impl Path {
             classes: cand.classes.clone(),
             alpha_from: pt.alpha,
             alpha_to: pt.alpha,
-            lambda_from: pt.lam.clone(),
-            lambda_to: pt.lam.clone(),
+            lambda_from: user.clone(),
+            lambda_to: user.clone(),
             direction: dir,
             orientation: cand.orientation,
             det_sign: cand.det_sign,

@@ -499,9 +499,9 @@ impl Path {
     /// basis loads it depends on the point alone, never on the window.
     fn force_scale(&self, pt: &Point) -> f64 {
         let r0 = self.problem.default_r();
-        let qg = shift_gap(&pt.q, self.problem.gap());
-        let terms =
-            self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b)) + inf_norm(self.problem.gap());
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+        let terms = self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b))
+            + inf_norm(self.problem.gap_equilibrated());
         inf_norm(&pt.lam)
             .max(r0 * inf_norm(&qg))
             .max(r0 * terms)
@@ -548,7 +548,7 @@ impl Path {
             .clone();
         let wl = displacement_gaps(abs_w.as_ref().as_ref(), &vec![0.0; m], &abs_lam);
         let qt = self.term_rows(pt);
-        let gap = self.problem.gap();
+        let gap = self.problem.gap_equilibrated();
         let p = self.problem.p();
         let rows: Vec<f64> = (0..m)
             .map(|k| {
@@ -588,11 +588,12 @@ impl Path {
         let u = self.problem.delassus().displacement(&f, lam);
         let residual = crate::piece::residual(&self.problem, &u, lam, &f);
         let p = self.problem.p();
+        let user = self.lam_to_user(lam);
         State {
             alpha,
             u,
-            lambda_n: lam[..p].to_vec(),
-            lambda_t: lam[p..].to_vec(),
+            lambda_n: user[..p].to_vec(),
+            lambda_t: user[p..].to_vec(),
             classes: classes.to_vec(),
             residual,
         }
@@ -610,6 +611,19 @@ impl Path {
         col
     }
 
+    /// Forces in the caller's units from the internal (equilibrated) ones: node i's
+    /// `(λν_i, λt_i)` divided by [`Problem::node_scale`]`[i]`.
+    fn lam_to_user(&self, lam: &[f64]) -> Vec<f64> {
+        let (s, p) = (self.problem.node_scale(), self.problem.p());
+        lam.iter().enumerate().map(|(k, v)| v / s[k % p]).collect()
+    }
+
+    /// The inverse of [`Self::lam_to_user`].
+    fn lam_to_internal(&self, lam: &[f64]) -> Vec<f64> {
+        let (s, p) = (self.problem.node_scale(), self.problem.p());
+        lam.iter().enumerate().map(|(k, v)| v * s[k % p]).collect()
+    }
+
     /// `d = q − (g, 0) + W λ` at a point (one product with W, cached for the last point).
     fn gaps(&self, pt: &Point) -> Arc<Vec<f64>> {
         if let Some((a, lam, d)) = &*self.gaps_cache.borrow()
@@ -618,7 +632,7 @@ impl Path {
         {
             return d.clone();
         }
-        let qg = shift_gap(&pt.q, self.problem.gap());
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let d = Arc::new(displacement_gaps(self.problem.delassus().w(), &qg, &pt.lam));
         *self.gaps_cache.borrow_mut() = Some((pt.alpha, pt.lam.clone(), d.clone()));
         d
@@ -733,7 +747,7 @@ impl Path {
     ) -> Option<PieceTangent> {
         let c = self.consts();
         let m = 2 * c.p;
-        let qg = shift_gap(&pt.q, self.problem.gap());
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let (mut js, _) = c.jacobian(self.problem.delassus().w(), classes, &qg, &pt.dq, pt.alpha);
         for r in 0..m {
             for col in 0..m {
@@ -784,8 +798,9 @@ impl Path {
             }
         }
         let pt = self.point_at(vec![0.0; m], alpha)?;
-        let qg = shift_gap(&pt.q, self.problem.gap());
-        let lam = solve_fixed_alpha(&self.problem, &qg, guess, alpha)?;
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+        let guess = guess.map(|g| self.lam_to_internal(g));
+        let lam = solve_fixed_alpha(&self.problem, &qg, guess.as_deref(), alpha)?;
         let pt = Point { lam, ..pt };
         let tol = self.tol_at(&pt);
         let p = self.problem.p();
@@ -832,8 +847,8 @@ impl Path {
             classes: cand.classes.clone(),
             alpha_from: alpha,
             alpha_to: alpha,
-            lambda_from: pt.lam.clone(),
-            lambda_to: pt.lam.clone(),
+            lambda_from: self.lam_to_user(&pt.lam),
+            lambda_to: self.lam_to_user(&pt.lam),
             direction: dir,
             orientation: cand.orientation,
             det_sign: cand.det_sign,
@@ -929,10 +944,11 @@ impl Path {
     }
 
     fn close_piece(&mut self, pt: &Point) {
+        let user = self.lam_to_user(&pt.lam);
         let tr = self.trace.as_mut().expect("started");
         let last = tr.pieces.last_mut().expect("one piece");
         last.alpha_to = pt.alpha;
-        last.lambda_to = pt.lam.clone();
+        last.lambda_to = user;
     }
 
     /// Steps until the path ends; returns why.

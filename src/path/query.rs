@@ -40,6 +40,7 @@ impl Path {
             ))
         })?;
         let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
+        let lam = self.lam_to_internal(&lam);
         let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
         Ok(self.state_with_force(&lam, e.alpha, &e.classes, f))
     }
@@ -79,8 +80,10 @@ impl Path {
         // Matching α with a piece's ends: relative to α and to the piece's own extent,
         // never to the window.
         let pt0 = self.point_at(vec![0.0; m], alpha)?;
-        let qg = shift_gap(&pt0.q, self.problem.gap());
+        let qg = shift_gap(&pt0.q, self.problem.gap_equilibrated());
         let mut out: Vec<Solution> = Vec::new();
+        // Internal λ of the solutions in `out`, for the duplicate test.
+        let mut seen: Vec<Vec<f64>> = Vec::new();
         for (k, pc) in pieces.iter().enumerate() {
             let (lo, hi) = (
                 pc.alpha_from.min(pc.alpha_to),
@@ -93,23 +96,23 @@ impl Path {
             let mut lams = Vec::new();
             let continuum = pc.direction == 0;
             if continuum {
-                lams.push(pc.lambda_from.clone());
-                lams.push(pc.lambda_to.clone());
+                lams.push(self.lam_to_internal(&pc.lambda_from));
+                lams.push(self.lam_to_internal(&pc.lambda_to));
             } else if (alpha - pc.alpha_from).abs() <= a_tol {
-                lams.push(pc.lambda_from.clone());
+                lams.push(self.lam_to_internal(&pc.lambda_from));
             } else if (alpha - pc.alpha_to).abs() <= a_tol {
-                lams.push(pc.lambda_to.clone());
+                lams.push(self.lam_to_internal(&pc.lambda_to));
             } else if self.load.is_affine() {
                 // Under an affine load a piece is a segment in (λ, α): exact from its ends,
                 // no factorisation.
                 let s = (alpha - pc.alpha_from) / (pc.alpha_to - pc.alpha_from);
-                lams.push(
-                    pc.lambda_from
-                        .iter()
-                        .zip(&pc.lambda_to)
-                        .map(|(a, b)| a + s * (b - a))
-                        .collect(),
-                );
+                let lam: Vec<f64> = pc
+                    .lambda_from
+                    .iter()
+                    .zip(&pc.lambda_to)
+                    .map(|(a, b)| a + s * (b - a))
+                    .collect();
+                lams.push(self.lam_to_internal(&lam));
             } else {
                 let c = self.consts();
                 let w = self.problem.delassus().w();
@@ -122,17 +125,15 @@ impl Path {
                     ..pt0.clone()
                 };
                 let scale = self.force_scale(&pt);
-                let dup = out.iter().any(|s| {
-                    s.state
-                        .lambda_n
-                        .iter()
-                        .chain(&s.state.lambda_t)
+                let dup = seen.iter().any(|l: &Vec<f64>| {
+                    l.iter()
                         .zip(&lam)
                         .all(|(a, b)| (a - b).abs() <= 1e-9 * scale)
                 });
                 if dup {
                     continue;
                 }
+                seen.push(lam.clone());
                 let state = self.state(&lam, alpha, &pc.classes)?;
                 out.push(Solution {
                     piece: k,
