@@ -200,6 +200,28 @@ impl<'a> PieceConstants<'a> {
             .collect()
     }
 
+    /// The right-hand side of [`Self::jacobian`] alone (O(m), no W needed).
+    pub fn jacobian_rhs(
+        &self,
+        classes: &[Class],
+        q_minus_g: &[f64],
+        dq: &[f64],
+        alpha: f64,
+    ) -> Vec<f64> {
+        let mut rhs = vec![0.0; 2 * self.p];
+        for (i, &c) in classes.iter().enumerate() {
+            for (k, form) in self.equations(i, c).iter().enumerate() {
+                let Term {
+                    index: bj,
+                    coef: bc,
+                } = form.disp;
+                rhs[if k == 0 { i } else { self.p + i }] =
+                    -(bc * q_minus_g[bj]) + bc * dq[bj] * alpha;
+            }
+        }
+        rhs
+    }
+
     /// The piece Jacobian `J_S` (m × (m+1)) at `q'` and the constant so that the piece is
     /// `J_S (λ, α) = rhs` at the current α (rhs computed from `q(α)` and α).
     pub fn jacobian(

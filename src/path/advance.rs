@@ -108,7 +108,7 @@ impl Path {
                     // piece's factorisation) and τ from the guard's equation; no drift
                     // from earlier points enters.
                     let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
-                    let (_, rhs) = c.jacobian(w, &cur.classes, &qg, &pt.dq, pt.alpha);
+                    let rhs = c.jacobian_rhs(&cur.classes, &qg, &pt.dq, pt.alpha);
                     let form = c.guard_form(g);
                     let mut row = vec![0.0; m + 1];
                     form.row(w, &pt.dq, &mut row);
