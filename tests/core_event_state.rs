@@ -2,6 +2,8 @@
 //! never call the load's closures (a host such as MATLAB answers them only during a step),
 //! and its u must solve A u = f(α) + Bᵀλ (checked with an independent dense solve).
 
+mod common;
+
 use std::sync::Arc;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -82,5 +84,46 @@ fn event_state_calls_no_closure_and_solves_the_equilibrium() {
             before,
             "event_state called the load closure"
         );
+    }
+}
+
+/// The blocked `event_states` equals `event_state` one event at a time (u to 1e-12
+/// relative, the residual to 1e-15 absolute, everything else exactly).
+#[test]
+fn blocked_event_states_equal_single_ones() {
+    for seed in 0..6u64 {
+        let case = common::fe_case(
+            seed,
+            8 + seed as usize,
+            2,
+            [0.3, 1.0, 3.0][seed as usize % 3],
+        );
+        let data = &case.data;
+        let path = common::trace(
+            std::sync::Arc::new(data.problem()),
+            data.affine_load(),
+            case.a0,
+            case.a1,
+        );
+        let n_ev = path.events().len();
+        assert!(n_ev > 0, "seed {seed}: no events");
+        let all = path.event_states(0..n_ev).unwrap();
+        for (k, s) in all.iter().enumerate() {
+            let one = path.event_state(k).unwrap();
+            assert_eq!(
+                (s.alpha, &s.lambda_n, &s.lambda_t, &s.classes),
+                (one.alpha, &one.lambda_n, &one.lambda_t, &one.classes),
+                "seed {seed}, event {k}"
+            );
+            let scale = one.u.iter().fold(1e-300f64, |m, v| m.max(v.abs()));
+            for (a, b) in s.u.iter().zip(&one.u) {
+                assert!((a - b).abs() <= 1e-12 * scale, "seed {seed}, event {k}: u");
+            }
+            assert!(
+                (s.residual - one.residual).abs() <= 1e-15,
+                "seed {seed}, event {k}"
+            );
+        }
+        assert!(path.event_states(0..n_ev + 1).is_err());
     }
 }

@@ -259,6 +259,16 @@ impl PathReport {
             lambda_t: s.lambda_t.clone(),
         });
         let list: Vec<Event> = path.events().to_vec();
+        // Residuals only; states in blocks so that no more than a block of u is held.
+        let residuals: Option<Vec<f64>> = (0..list.len())
+            .step_by(64)
+            .map(|a| {
+                path.event_states(a..(a + 64).min(list.len()))
+                    .map(|v| v.into_iter().map(|s| s.residual).collect::<Vec<f64>>())
+            })
+            .collect::<fricont::Result<Vec<_>>>()
+            .ok()
+            .map(|v| v.concat());
         let mut events: Vec<EventReport> = Vec::with_capacity(list.len());
         for e in &list {
             events.push(EventReport {
@@ -269,7 +279,7 @@ impl PathReport {
                 to: e.to.name(),
                 fold: e.fold,
                 bifurcation: e.bifurcation,
-                residual: path.event_state(e.index).map_or(f64::NAN, |s| s.residual),
+                residual: residuals.as_ref().map_or(f64::NAN, |r| r[e.index]),
                 transition: e.transition + 1,
                 lambda_n: e.lambda_n.get(e.node).copied(),
                 lambda_t: e.lambda_t.get(e.node).copied(),

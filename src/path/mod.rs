@@ -586,7 +586,19 @@ impl Path {
 
     fn state_with_force(&self, lam: &[f64], alpha: f64, classes: &[Class], f: Vec<f64>) -> State {
         let u = self.problem.delassus().displacement(&f, lam);
-        let residual = crate::piece::residual(&self.problem, &u, lam, &f);
+        self.state_from_u(lam, alpha, classes, &f, u)
+    }
+
+    /// The state with u already solved for.
+    fn state_from_u(
+        &self,
+        lam: &[f64],
+        alpha: f64,
+        classes: &[Class],
+        f: &[f64],
+        u: Vec<f64>,
+    ) -> State {
+        let residual = crate::piece::residual(&self.problem, &u, lam, f);
         let p = self.problem.p();
         let user = self.lam_to_user(lam);
         State {

@@ -45,6 +45,68 @@ impl Path {
         Ok(self.state_with_force(&lam, e.alpha, &e.classes, f))
     }
 
+    /// The full states of events `range` (as [`Path::event_state`]), with the back-solves
+    /// done in blocks of 32 right-hand sides (several times faster per event than one at
+    /// a time on large meshes) and one state per transition point (events of one
+    /// transition share it). Errors: not started, the range exceeds the events.
+    pub fn event_states(&self, range: std::ops::Range<usize>) -> Result<Vec<State>> {
+        let tr = self.trace_ref()?;
+        if range.end > tr.events.len() || range.start > range.end {
+            return Err(Error::Usage(format!(
+                "events {}..{} do not exist ({} events)",
+                range.start,
+                range.end,
+                tr.events.len()
+            )));
+        }
+        let n = self.problem.n();
+        // One solve per transition point in the range.
+        let mut firsts: Vec<usize> = Vec::new();
+        for k in range.clone() {
+            if firsts
+                .last()
+                .is_none_or(|&j| tr.events[j].transition != tr.events[k].transition)
+            {
+                firsts.push(k);
+            }
+        }
+        let mut by_transition: Vec<State> = Vec::with_capacity(firsts.len());
+        for block in firsts.chunks(32) {
+            let mut x = faer::Mat::<f64>::zeros(n, block.len());
+            let mut inputs = Vec::with_capacity(block.len());
+            for (c, &k) in block.iter().enumerate() {
+                let e = &tr.events[k];
+                let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
+                let lam = self.lam_to_internal(&lam);
+                let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
+                let mut rhs = f.clone();
+                self.problem.b().mul_t_vec_add(&lam, &mut rhs);
+                for (i, v) in rhs.into_iter().enumerate() {
+                    x[(i, c)] = v;
+                }
+                inputs.push((k, lam, f));
+            }
+            self.problem.delassus().solve_mat_in_place(x.as_mut());
+            for (c, (k, lam, f)) in inputs.into_iter().enumerate() {
+                let e = &tr.events[k];
+                let u: Vec<f64> = (0..n).map(|i| x[(i, c)]).collect();
+                by_transition.push(self.state_from_u(&lam, e.alpha, &e.classes, &f, u));
+            }
+        }
+        let mut out = Vec::with_capacity(range.len());
+        let mut t = 0;
+        for k in range {
+            if t + 1 < firsts.len() && k >= firsts[t + 1] {
+                t += 1;
+            }
+            let mut s = by_transition[t].clone();
+            // Events of one transition share the point; the classes are the event's own.
+            s.classes = tr.events[k].classes.clone();
+            out.push(s);
+        }
+        Ok(out)
+    }
+
     /// The pieces so far (the last one is the current piece; empty before the start).
     pub fn pieces(&self) -> &[PieceRecord] {
         self.trace
