@@ -73,9 +73,13 @@ build_reference() {
 }
 
 # compare_events REF GOT [RTOL]: the event lines agree (same nodes, classes, flags, and
-# alpha within RTOL relative, default 1e-12), and so do the start α and the end line.
+# alpha within RTOL relative, default 1e-10), and so do the start α and the end line.
+# 1e-10, not 1e-12: the sample's event 3 is a shallow crossing that the data determine to
+# ~2e-11 relative only (it moves 3.4e-12 under a 4-ulp perturbation of A, see
+# tests/core_sample.rs), so two interfaces that hand over the same matrix in different
+# storage (full/lower, CSC/CSR) may differ there by more than 1e-12.
 compare_events() {
-    awk -v rtol="${3:-1e-12}" '
+    awk -v rtol="${3:-1e-10}" '
         function abs(x) { return x < 0 ? -x : x }
         function near(a, b) { return abs(a - b) <= rtol * (abs(b) > 1 ? abs(b) : 1) }
         FNR == NR { ref[FNR] = $0; nref = FNR; next }

@@ -75,7 +75,7 @@ if command -v gfortran >/dev/null 2>&1; then
             '$ROOT/fortran/examples/case_reader.f90' '$ROOT/fortran/examples/trace_sample.f90' &&
             gfortran -o pc_fortran fricont.o case_reader.o trace_sample.o \$(pkg-config --libs fricont) $RPATH &&
             ./pc_fortran '$CASE' > pcf.txt && source '$ROOT/tests-install/common.sh' &&
-            compare_events ref.txt pcf.txt 1e-12"
+            compare_events ref.txt pcf.txt"
 fi
 
 # --- CMake find_package ---------------------------------------------------------------
@@ -117,6 +117,6 @@ if [ -x "$LIBDIR/fricont" ]; then
     run_check "fricont trace --json: same events as the C interface" \
         bash -c "'$LIBDIR/fricont' trace '$CASE' --json cli.json > /dev/null &&
             python3 '$ROOT/tests-install/cjson_events.py' cli.json > cli.txt &&
-            source '$ROOT/tests-install/common.sh' && compare_events ref.txt cli.txt 1e-12"
+            source '$ROOT/tests-install/common.sh' && compare_events ref.txt cli.txt"
 fi
 finish

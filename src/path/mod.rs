@@ -787,6 +787,9 @@ impl Path {
     /// fails, the load fails, no piece leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
         self.trace = None;
+        // A path's numbers depend on its own history only: no factorisation from an
+        // earlier start is reused.
+        *self.updater.borrow_mut() = None;
         let (lo, hi) = self.window();
         if !(alpha >= lo && alpha <= hi) {
             return Err(Error::InvalidParameter(format!(
