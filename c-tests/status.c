@@ -166,7 +166,7 @@ static void test_csr_errors(void) {
     double v2[] = {1.0, 1.0};
     fricont_csr n2 = mk(2, 2, 2, rp2, ci2, v2, 0);
     EXPECT(fricont_problem_new(&a, 0, &n2, &n2, &p), FRICONT_OK, "");
-    EXPECT(fricont_problem_build(p), FRICONT_ERR_RANK_DEFICIENT, "2p = 4 exceeds n = 2");
+    EXPECT(fricont_problem_build(p), FRICONT_ERR_LENGTH, "2p = 4 exceeds n = 2");
     fricont_problem_free(p);
 }
 

@@ -70,7 +70,8 @@ impl CsrMatrix {
         let nnz = values.len();
         let mut rp = Vec::with_capacity(nrows + 1);
         for (i, &r) in row_ptr.iter().enumerate() {
-            let r0 = r - index_base;
+            // saturating: i64::MIN - 1 must be "out of range", not an overflow
+            let r0 = r.saturating_sub(index_base);
             if i > 0 && r < row_ptr[i - 1] {
                 return Err(Error::Csr(format!(
                     "{name} (CSR): row pointer decreases at row {} ({} after {})",
@@ -98,14 +99,14 @@ impl CsrMatrix {
         for i in 0..nrows {
             row.clear();
             for k in rp[i]..rp[i + 1] {
-                let c = col_idx[k] - index_base;
+                let c = col_idx[k].saturating_sub(index_base);
                 if c < 0 || c as u64 >= ncols as u64 {
                     return Err(Error::Csr(format!(
                         "{name} (CSR): row {} has column index {} outside {}..{} (ncols {ncols}, index base {index_base})",
                         i as i64 + index_base,
                         col_idx[k],
                         index_base,
-                        ncols as i64 + index_base
+                        (ncols as i64).saturating_add(index_base)
                     )));
                 }
                 if !values[k].is_finite() {
@@ -365,7 +366,8 @@ impl ProblemBuilder {
     /// Validates the data, factorises `A` (sparse Cholesky, fill-reducing ordering) and
     /// forms `W = B A⁻¹ Bᵀ`.
     ///
-    /// Errors: [`Error::Dimension`] (A not square, N/T not p×n, F or g of wrong length),
+    /// Errors: [`Error::Dimension`] (A not square, N/T not p×n, 2p > n, F or g of wrong
+    /// length),
     /// [`Error::NotSymmetric`], [`Error::Csr`] (entries in the wrong triangle),
     /// [`Error::NonFinite`], [`Error::NotSpd`] (with the pivot), [`Error::RankDeficient`]
     /// (B = [N; T] without full row rank 2p), [`Error::InvalidParameter`] (F < 0 or not
@@ -395,7 +397,7 @@ impl ProblemBuilder {
             }
         }
         if 2 * p > n {
-            return Err(Error::RankDeficient(format!(
+            return Err(Error::Dimension(format!(
                 "2p = {} exceeds n = {n}, so B = [N; T] cannot have full row rank",
                 2 * p
             )));

@@ -489,7 +489,12 @@ fn rank_deficient_b() {
     ];
     for (what, n, t) in cases {
         let e = build_err(what, ProblemBuilder::new(a(), Storage::Full, n, t));
-        assert!(matches!(e, Error::RankDeficient(_)), "{what}: {e:?}");
+        if what == "2p > n" {
+            // a size error (FRICONT_ERR_LENGTH), found before anything is factorised
+            assert!(matches!(e, Error::Dimension(_)), "{what}: {e:?}");
+        } else {
+            assert!(matches!(e, Error::RankDeficient(_)), "{what}: {e:?}");
+        }
     }
     // numerically rank-deficient: T = N (1 + 1e-15)
     let e = build_err(
@@ -703,4 +708,26 @@ fn load_failures_stop_cleanly() {
     assert!(!ev.is_empty(), "events before the failure were lost");
     assert!(ev[0].alpha.abs() <= 1e-12, "{:?}", ev[0]);
     assert!(ev.iter().all(|e| e.alpha <= fail_at));
+}
+
+/// Extreme int64 indices in CSR input are reported as CSR errors, in debug builds too
+/// (no arithmetic overflow on the way).
+#[test]
+fn csr_extreme_indices_are_errors_not_overflows() {
+    for base in [0i64, 1] {
+        // a row pointer of i64::MIN
+        let e = CsrMatrix::from_raw("M", 1, 2, &[base, i64::MIN], &[base], &[1.0], base);
+        assert!(matches!(e, Err(Error::Csr(_))), "base {base}: {e:?}");
+        // a column index of i64::MIN and of i64::MAX
+        for c in [i64::MIN, i64::MAX] {
+            let e = CsrMatrix::from_raw("M", 1, 2, &[base, base + 1], &[c], &[1.0], base);
+            assert!(
+                matches!(e, Err(Error::Csr(_))),
+                "base {base}, column {c}: {e:?}"
+            );
+        }
+        // a first row pointer of i64::MAX
+        let e = CsrMatrix::from_raw("M", 1, 2, &[i64::MAX, i64::MAX], &[], &[], base);
+        assert!(matches!(e, Err(Error::Csr(_))), "base {base}: {e:?}");
+    }
 }
