@@ -199,6 +199,11 @@ static void test_problem_setters(void) {
     EXPECT(fricont_problem_set_r(p, 3.0), FRICONT_OK, "");
     EXPECT(fricont_problem_r(p, &r, &r0), FRICONT_OK, "");
     CHECK(r == 3.0 && fabs(r0 - 4.0 / 3.0) < 1e-15, "r after set_r %g", r);
+    /* r far from the default: refused, the setting unchanged */
+    EXPECT(fricont_problem_set_r(p, 1e300), FRICONT_ERR_RANGE, "outside [1e-6, 1e6]");
+    EXPECT(fricont_problem_set_r(p, 1e-300), FRICONT_ERR_RANGE, "outside [1e-6, 1e6]");
+    EXPECT(fricont_problem_r(p, &r, &r0), FRICONT_OK, "");
+    CHECK(r == 3.0, "r after refused set_r %g", r);
     /* snprintf semantics of the messages */
     EXPECT(fricont_problem_set_friction(p, -7.0), FRICONT_ERR_RANGE, "F = -7");
     size_t full = fricont_problem_error_message(p, NULL, 0);

@@ -701,7 +701,9 @@ fricont_status fricont_problem_set_gap(struct fricont_problem *problem,
  * factorisation (no new Cholesky of A).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (r ≤ 0 or not
- * finite), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * finite; or, once the problem is built, r outside [1e-6, 1e6] × the default — the
+ * setting is then unchanged; before the build that range is checked by
+ * `fricont_problem_build`), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
  *
  * # Safety
  * `problem` is NULL or a live handle.
@@ -719,7 +721,8 @@ fricont_status fricont_problem_set_r(struct fricont_problem *problem,
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_NOT_SYMMETRIC`,
  * `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
- * the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n),
+ * the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n), `FRICONT_ERR_RANGE`
+ * (an r set outside [1e-6, 1e6] × the default 2p / trace(W)),
  * `FRICONT_ERR_NUMERICAL` (out of memory), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
  *
  * # Safety

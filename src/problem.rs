@@ -371,7 +371,7 @@ impl ProblemBuilder {
     /// [`Error::NotSymmetric`], [`Error::Csr`] (entries in the wrong triangle),
     /// [`Error::NonFinite`], [`Error::NotSpd`] (with the pivot), [`Error::RankDeficient`]
     /// (B = [N; T] without full row rank 2p), [`Error::InvalidParameter`] (F < 0 or not
-    /// finite, r ≤ 0 or not finite, p = 0).
+    /// finite, r ≤ 0 or not finite or `r / r0` outside [`R_RANGE`], p = 0).
     pub fn build(self) -> Result<Problem> {
         let n = self.a.nrows();
         if self.a.ncols() != n {
@@ -467,6 +467,7 @@ impl ProblemBuilder {
         let delassus = std::sync::Arc::new(Delassus::new(&lower, &b)?);
         let r_default = delassus.default_r();
         let r = self.r.unwrap_or(r_default);
+        check_r(r, r_default)?;
         Ok(Problem {
             n,
             p,
@@ -616,6 +617,28 @@ fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatr
     }
 }
 
+/// The accepted range of `r / r0` (r0 = [`Problem::default_r`]). Solutions do not
+/// depend on r, but the fixed-α solver's equations mix `λ` and `r (N u − g)`: far outside
+/// this range one of them drowns in the other's rounding (the sample fails to start at
+/// 1e-8 · r0 and at 1e10 · r0, and works from 1e-6 to 1e8).
+pub const R_RANGE: (f64, f64) = (1e-6, 1e6);
+
+fn check_r(r: f64, r_default: f64) -> Result<()> {
+    if !r.is_finite() || r <= 0.0 {
+        return Err(Error::InvalidParameter(format!(
+            "r = {r}, must be finite and > 0"
+        )));
+    }
+    let rel = r / r_default;
+    if !(R_RANGE.0..=R_RANGE.1).contains(&rel) {
+        return Err(Error::InvalidParameter(format!(
+            "r = {r:e} is outside [{:e}, {:e}] × the default r0 = 2p / trace(W) = {r_default:e} (r does not change the solutions; leave it at its default)",
+            R_RANGE.0, R_RANGE.1
+        )));
+    }
+    Ok(())
+}
+
 /// A validated, factorised contact problem. Immutable; share it with `Arc`.
 #[derive(Debug)]
 pub struct Problem {
@@ -685,13 +708,9 @@ impl Problem {
         &self.delassus
     }
     /// A copy of this problem with another `r`; the factor of A and W are shared, not
-    /// recomputed. Errors: r ≤ 0 or not finite.
+    /// recomputed. Errors: r ≤ 0 or not finite, `r / default_r()` outside [`R_RANGE`].
     pub fn with_r(&self, r: f64) -> Result<Problem> {
-        if !r.is_finite() || r <= 0.0 {
-            return Err(Error::InvalidParameter(format!(
-                "r = {r}, must be finite and > 0"
-            )));
-        }
+        check_r(r, self.r_default)?;
         Ok(Problem {
             n: self.n,
             p: self.p,

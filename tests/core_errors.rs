@@ -3,6 +3,8 @@
 //! nothing panics (each call runs under `catch_unwind`, so a panic fails with a message
 //! naming the case instead of aborting the test).
 
+mod common;
+
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::Arc;
 
@@ -729,5 +731,29 @@ fn csr_extreme_indices_are_errors_not_overflows() {
         // a first row pointer of i64::MAX
         let e = CsrMatrix::from_raw("M", 1, 2, &[i64::MAX, i64::MAX], &[], &[], base);
         assert!(matches!(e, Err(Error::Csr(_))), "base {base}: {e:?}");
+    }
+}
+
+/// r far from the default 2p / trace(W) is refused at the build and by `with_r` (a range
+/// error naming the accepted range); r within it is accepted.
+#[test]
+fn r_outside_its_range_is_refused() {
+    let data = common::one_node(0.3, [0.0, -1.0, 0.0], [0.1, 0.0, 0.0]);
+    let p = data.problem();
+    let r0 = p.default_r();
+    for r in [1e300, 1e-300, 2e6 * r0, 5e-7 * r0] {
+        let e = data.builder().r(r).build().map(|_| ()).unwrap_err();
+        assert!(
+            matches!(&e, Error::InvalidParameter(m) if m.contains("outside")),
+            "{r:e}: {e:?}"
+        );
+        let e = p.with_r(r).map(|_| ()).unwrap_err();
+        assert!(
+            matches!(&e, Error::InvalidParameter(m) if m.contains("outside")),
+            "{r:e}: {e:?}"
+        );
+    }
+    for r in [1e-6 * r0, 1e6 * r0, 10.0 * r0] {
+        assert_eq!(p.with_r(r).unwrap().r(), r);
     }
 }

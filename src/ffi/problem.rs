@@ -365,7 +365,9 @@ pub unsafe extern "C" fn fricont_problem_set_gap(
 /// factorisation (no new Cholesky of A).
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (r ≤ 0 or not
-/// finite), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// finite; or, once the problem is built, r outside [1e-6, 1e6] × the default — the
+/// setting is then unchanged; before the build that range is checked by
+/// `fricont_problem_build`), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
 ///
 /// # Safety
 /// `problem` is NULL or a live handle.
@@ -381,11 +383,17 @@ pub unsafe extern "C" fn fricont_problem_set_r(
             return Err(Failure::range(format!("r = {r}, must be finite and > 0")));
         }
         let mut inner = h.lock();
+        // Built already: the range check (r relative to the default) happens first, so
+        // that a refused r leaves the handle as it was.
+        let rebuilt = match inner.built.as_ref() {
+            Some(p) => Some(Arc::new(p.with_r(r)?)),
+            None => None,
+        };
+        if rebuilt.is_some() {
+            inner.built = rebuilt;
+        }
         let b = inner.builder.take().expect("builder present outside a setter");
         inner.builder = Some(b.r(r));
-        if let Some(p) = inner.built.take() {
-            inner.built = Some(Arc::new(p.with_r(r)?));
-        }
         Ok(fricont_status::FRICONT_OK)
     })
 }
@@ -399,7 +407,8 @@ pub unsafe extern "C" fn fricont_problem_set_r(
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_NOT_SYMMETRIC`,
 /// `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
-/// the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n),
+/// the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n), `FRICONT_ERR_RANGE`
+/// (an r set outside [1e-6, 1e6] × the default 2p / trace(W)),
 /// `FRICONT_ERR_NUMERICAL` (out of memory), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
 ///
 /// # Safety
