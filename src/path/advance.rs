@@ -262,6 +262,26 @@ impl Path {
             }
             let at_bound = at_bound && cut.is_none();
             let delta = pb.alpha - pa.alpha;
+            // The step is trusted only where the cubic Hermite model of every guard (from
+            // the values and slopes at both ends) predicts a fresh evaluation at the
+            // midpoint to within a quarter of the guard's smallest margin on the step: a
+            // load that changes faster than the step resolves (an excursion of a guard
+            // below zero and back inside one step) fails this test and shortens the step.
+            // A guard already negative at the midpoint is a crossing inside the step.
+            if h > hmin {
+                let (_, gm) = eval(self, pa.alpha + 0.5 * delta)?;
+                let untrusted = (0..gb.len()).any(|k| {
+                    let (v0, v1, vm) = (ga[k].value, gb[k].value, gm[k].value);
+                    let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
+                    let model = 0.5 * (v0 + v1) + 0.125 * (m0 - m1);
+                    let margin = v0.min(v1).min(vm).max(tol[k]);
+                    vm < -tol[k] || (vm - model).abs() > 0.25 * margin
+                });
+                if untrusted {
+                    h = 0.5 * delta.abs();
+                    continue;
+                }
+            }
             let crossing: Vec<usize> = (0..gb.len()).filter(|&k| gb[k].value < -tol[k]).collect();
             if crossing.is_empty() {
                 // Hermite check for a dip below zero inside the step

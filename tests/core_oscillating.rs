@@ -1,0 +1,79 @@
+//! Oscillating loads with analytic transitions: every narrow excursion of a guard below
+//! zero is found (issue: steps certified only by end-point derivatives skipped them).
+//!
+//! One node, A = I (2 dofs), N = [1, 0], T = [0, 1], no gap, load f(α) = (c(α), 0) with
+//! c(α) = 0.9 + sin(20α): the node is open where c ≤ 0 (u = f) and sticks where c > 0
+//! (u_n = 0, λν = −c, λt = 0), so the transitions are exactly the roots of c on the
+//! window, where sin(20α) = −0.9: 64 of them on [−5, 5], each open for a stretch of
+//! α of width 0.045 only (1/220 of the window).
+
+use std::f64::consts::PI;
+use std::sync::Arc;
+
+use fricont::load::LoadFailure;
+use fricont::{Class, CsrMatrix, EndReason, Load, Path, PathOptions, ProblemBuilder, Storage};
+
+fn roots(a0: f64, a1: f64) -> Vec<(f64, Class, Class)> {
+    let s = (-0.9f64).asin(); // in (−π/2, 0)
+    let mut out = Vec::new();
+    for k in -40..40 {
+        let base = 2.0 * PI * k as f64;
+        // sin decreasing through −0.9 at π − s: contact → open; increasing at 2π + s: open → contact
+        let down = (PI - s + base) / 20.0;
+        let up = (2.0 * PI + s + base) / 20.0;
+        for (a, from, to) in [
+            (down, Class::Stick, Class::Open),
+            (up, Class::Open, Class::Stick),
+        ] {
+            if a > a0 && a < a1 {
+                out.push((a, from, to));
+            }
+        }
+    }
+    out.sort_by(|x, y| x.0.total_cmp(&y.0));
+    out
+}
+
+#[test]
+fn one_node_sine_load_finds_every_transition() {
+    let a = CsrMatrix::from_dense(2, 2, &[1.0, 0.0, 0.0, 1.0]).unwrap();
+    let n = CsrMatrix::from_dense(1, 2, &[1.0, 0.0]).unwrap();
+    let t = CsrMatrix::from_dense(1, 2, &[0.0, 1.0]).unwrap();
+    let problem = Arc::new(
+        ProblemBuilder::new(a, Storage::Full, n, t)
+            .friction_uniform(0.3)
+            .build()
+            .unwrap(),
+    );
+    let f = Box::new(|al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+        out[0] = 0.9 + (20.0 * al).sin();
+        out[1] = 0.0;
+        Ok(())
+    });
+    let df = Box::new(|al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+        out[0] = 20.0 * (20.0 * al).cos();
+        out[1] = 0.0;
+        Ok(())
+    });
+    let (a0, a1) = (-5.0, 5.0);
+    let mut path = Path::new(
+        problem,
+        Load::general(2, f, Some(df)),
+        PathOptions::window(a0, a1),
+    )
+    .unwrap();
+    path.start(a0, None).unwrap();
+    assert_eq!(path.run().unwrap(), EndReason::Window);
+    let want = roots(a0, a1);
+    assert_eq!(want.len(), 64);
+    let got: Vec<(f64, Class, Class)> = path
+        .events()
+        .iter()
+        .map(|e| (e.alpha, e.from, e.to))
+        .collect();
+    assert_eq!(got.len(), want.len(), "events {got:?}");
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g.0 - w.0).abs() <= 1e-10, "α {} expected {}", g.0, w.0);
+        assert_eq!((g.1, g.2), (w.1, w.2), "at α = {}", w.0);
+    }
+}
