@@ -7,6 +7,8 @@
 //! window, where sin(20α) = −0.9: 64 of them on [−5, 5], each open for a stretch of
 //! α of width 0.045 only (1/220 of the window).
 
+mod common;
+
 use std::f64::consts::PI;
 use std::sync::Arc;
 
@@ -76,4 +78,84 @@ fn one_node_sine_load_finds_every_transition() {
         assert!((g.0 - w.0).abs() <= 1e-10, "α {} expected {}", g.0, w.0);
         assert_eq!((g.1, g.2), (w.1, w.2), "at α = {}", w.0);
     }
+}
+
+/// A finite-element mesh under `f(α) = f0 + A sin(50 α) f1` over three periods: every
+/// transition point of the affine path with |φ| < A is met six times (up and down in each
+/// period), at the α where A sin(50 α) equals it. Reference: the same mesh traced under
+/// the affine load `f0 + φ f1` on [−A, A] (fold-free cases only), mapped through asin.
+#[test]
+fn finite_element_sine_shear_finds_every_transition() {
+    let mut checked = 0;
+    for seed in 0..12u64 {
+        let case = common::fe_case(seed, 6, 2, 0.5);
+        let data = &case.data;
+        let problem = Arc::new(data.problem());
+        let amp = 2.0;
+        let affine = common::trace(problem.clone(), data.affine_load(), -amp, amp);
+        let aff: Vec<&fricont::Event> = affine.events().iter().collect();
+        if aff.is_empty() || aff.iter().any(|e| e.fold || e.bifurcation) {
+            continue;
+        }
+        // expected α (with class change) in three periods of 50 α, from α = −π/100
+        // (φ = −A) upward
+        let period = 2.0 * PI / 50.0;
+        let a0 = -PI / 100.0;
+        let mut want: Vec<(f64, usize, Class, Class)> = Vec::new();
+        for k in 0..3 {
+            let base = a0 + k as f64 * period;
+            for e in &aff {
+                let s = (e.alpha / amp).asin(); // in (−π/2, π/2)
+                // φ increasing through e.alpha: 50 α − 50 a0 = s + π/2 (from φ = −A)
+                let up = base + (s + PI / 2.0) / 50.0;
+                let down = base + (1.5 * PI - s) / 50.0;
+                want.push((up, e.node, e.from, e.to));
+                want.push((down, e.node, e.to, e.from));
+            }
+        }
+        want.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
+        let n = f0.len();
+        let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+            let s = amp * (50.0 * al).sin();
+            for ((o, a), b) in out.iter_mut().zip(&f0).zip(&f1) {
+                *o = a + s * b;
+            }
+            Ok(())
+        });
+        let mut path = Path::new(
+            problem,
+            Load::general(n, f, None),
+            PathOptions::window(a0, a0 + 3.0 * period),
+        )
+        .unwrap();
+        path.start(a0, None).unwrap();
+        assert_eq!(path.run().unwrap(), EndReason::Window, "seed {seed}");
+        let got = path.events();
+        assert_eq!(
+            got.len(),
+            want.len(),
+            "seed {seed}: {} events, expected {}",
+            got.len(),
+            want.len()
+        );
+        for (g, w) in got.iter().zip(&want) {
+            // compare in φ: the affine event is determined to 1e-12 there
+            let (pg, pw) = (amp * (50.0 * g.alpha).sin(), amp * (50.0 * w.0).sin());
+            assert!(
+                (pg - pw).abs() <= 1e-10,
+                "seed {seed}: φ {pg} expected {pw} (α {} vs {})",
+                g.alpha,
+                w.0
+            );
+            assert_eq!(
+                (g.node, g.from, g.to),
+                (w.1, w.2, w.3),
+                "seed {seed} at α {}",
+                w.0
+            );
+        }
+        checked += 1;
+    }
+    assert!(checked >= 4, "only {checked} fold-free cases");
 }
