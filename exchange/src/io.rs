@@ -12,6 +12,9 @@
 //!   or the upper one); it is expanded to full storage. Values must be finite.
 //! - Vector files: one number a line (blank lines ignored), finite, exactly `n` (`f0`,
 //!   `f1`) or `p` (`gap`) of them.
+//! - Compression: any of these files may instead be given gzip-compressed as `NAME.gz`
+//!   (`A.mtx.gz`, …); it is read when `NAME` itself does not exist (the plain file wins
+//!   when both do). Errors then name the `.gz` file and count the lines of its text.
 //! - `meta.json`: an object with `n`, `p` (positive integers), `F` (a number ≥ 0 or an
 //!   array of `p` numbers ≥ 0), `alpha_start`, `alpha_end` (finite numbers); any other keys
 //!   are kept in [`CaseData::meta`] and written back by [`CaseData::write_dir`]. `n` and `p`
@@ -57,7 +60,7 @@ impl CaseData {
     /// matrices or vectors).
     pub fn read_dir(dir: &std::path::Path) -> Result<CaseData> {
         let meta_path = dir.join("meta.json");
-        let meta_text = read_text(&meta_path)?;
+        let (meta_path, meta_text) = read_text(&meta_path)?;
         let meta = parse_meta(&meta_path, &meta_text)?;
 
         let a = read_mtx(
@@ -78,7 +81,7 @@ impl CaseData {
         let f0 = read_vector(&dir.join("f0.txt"), meta.n, "n")?;
         let f1 = read_vector(&dir.join("f1.txt"), meta.n, "n")?;
         let gap_path = dir.join("gap.txt");
-        let gap = if gap_path.exists() {
+        let gap = if gap_path.exists() || dir.join("gap.txt.gz").exists() {
             Some(read_vector(&gap_path, meta.p, "p")?)
         } else {
             None
@@ -245,8 +248,28 @@ fn io_err(path: &FsPath, line: Option<usize>, msg: impl std::fmt::Display) -> Er
     }
 }
 
-fn read_text(path: &FsPath) -> Result<String> {
-    std::fs::read_to_string(path).map_err(|e| io_err(path, None, format!("cannot read: {e}")))
+/// Reads a text file; if `path` does not exist but `path.gz` does, that file is
+/// decompressed instead (errors then name the `.gz` file; line numbers count lines of the
+/// decompressed text).
+fn read_text(path: &FsPath) -> Result<(std::path::PathBuf, String)> {
+    if !path.exists() {
+        let mut gz = path.as_os_str().to_owned();
+        gz.push(".gz");
+        let gz = std::path::PathBuf::from(gz);
+        if gz.exists() {
+            use std::io::Read as _;
+            let file = std::fs::File::open(&gz)
+                .map_err(|e| io_err(&gz, None, format!("cannot read: {e}")))?;
+            let mut text = String::new();
+            flate2::read::MultiGzDecoder::new(std::io::BufReader::new(file))
+                .read_to_string(&mut text)
+                .map_err(|e| io_err(&gz, None, format!("cannot decompress: {e}")))?;
+            return Ok((gz, text));
+        }
+    }
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| io_err(path, None, format!("cannot read: {e}")))?;
+    Ok((path.to_path_buf(), text))
 }
 
 fn write_text(path: &FsPath, text: &str) -> Result<()> {
@@ -375,8 +398,8 @@ fn parse_count(path: &FsPath, line: usize, tok: &str, what: &str) -> Result<usiz
 /// Reads a Matrix Market coordinate file into full-storage CSR. `expect` (rows, cols), if
 /// given, is checked against the size line (`expect_what` explains where it comes from).
 fn read_mtx(path: &FsPath, expect: Option<(usize, usize)>, expect_what: &str) -> Result<CsrMatrix> {
-    let text = read_text(path)?;
-    parse_mtx(path, &text, expect, expect_what)
+    let (path, text) = read_text(path)?;
+    parse_mtx(&path, &text, expect, expect_what)
 }
 
 fn parse_mtx(
@@ -582,8 +605,8 @@ fn parse_mtx(
 
 /// Reads `expect` numbers, one a line (blank lines ignored).
 fn read_vector(path: &FsPath, expect: usize, expect_name: &str) -> Result<Vec<f64>> {
-    let text = read_text(path)?;
-    parse_vector(path, &text, expect, expect_name)
+    let (path, text) = read_text(path)?;
+    parse_vector(&path, &text, expect, expect_name)
 }
 
 fn parse_vector(path: &FsPath, text: &str, expect: usize, expect_name: &str) -> Result<Vec<f64>> {
@@ -645,6 +668,62 @@ fn vector_text(v: &[f64]) -> String {
 
 #[cfg(test)]
 mod tests {
+
+    /// A problem directory with every file gzip-compressed reads as the plain one; a
+    /// corrupt entry in a compressed file is reported with the .gz name and its line.
+    #[test]
+    fn gzip_files_are_read() {
+        use std::io::Write as _;
+        let dir = std::env::temp_dir().join(format!("fricont-gz-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let case = crate::generator::generate(&crate::generator::RectSpec {
+            nx: 5,
+            ny: 3,
+            gap: 0.01,
+            ..crate::generator::RectSpec::press_shear()
+        })
+        .unwrap();
+        case.write_dir(&dir).unwrap();
+        for name in [
+            "A.mtx",
+            "N.mtx",
+            "T.mtx",
+            "f0.txt",
+            "f1.txt",
+            "gap.txt",
+            "meta.json",
+        ] {
+            let plain = dir.join(name);
+            let bytes = std::fs::read(&plain).unwrap();
+            let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+            enc.write_all(&bytes).unwrap();
+            std::fs::write(dir.join(format!("{name}.gz")), enc.finish().unwrap()).unwrap();
+            std::fs::remove_file(&plain).unwrap();
+        }
+        let back = CaseData::read_dir(&dir).unwrap();
+        assert_eq!(back, case);
+        // corrupt line 5 of A.mtx.gz
+        let text = {
+            use std::io::Read as _;
+            let mut s = String::new();
+            flate2::read::GzDecoder::new(std::fs::File::open(dir.join("A.mtx.gz")).unwrap())
+                .read_to_string(&mut s)
+                .unwrap();
+            s
+        };
+        let mut lines: Vec<&str> = text.lines().collect();
+        let bad = lines.iter().position(|l| !l.starts_with('%')).unwrap() + 2;
+        lines[bad] = "1 1 abc";
+        let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+        enc.write_all(lines.join("\n").as_bytes()).unwrap();
+        std::fs::write(dir.join("A.mtx.gz"), enc.finish().unwrap()).unwrap();
+        let err = CaseData::read_dir(&dir).unwrap_err().to_string();
+        assert!(
+            err.contains(&format!("A.mtx.gz:{}:", bad + 1)) && err.contains("abc"),
+            "{err}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
     use super::*;
     use std::path::PathBuf;
 
