@@ -122,6 +122,11 @@ enum fricont_status
      */
     FRICONT_ERR_ORDER = -104,
     /**
+     * Usage: the displacement u was asked of a problem that cannot compute it (made by
+     * `fricont_problem_new_condensed`): pass NULL for u there.
+     */
+    FRICONT_ERR_UNAVAILABLE = -105,
+    /**
      * Data: a malformed CSR matrix (index base not 0 or 1, row pointer not starting at
      * the base or decreasing or not ending at the base + nnz, column out of range,
      * duplicate entry in a row, an entry of A in the wrong triangle for the storage).
@@ -132,11 +137,13 @@ enum fricont_status
      */
     FRICONT_ERR_NONFINITE = -202,
     /**
-     * Data: A given in full storage is not symmetric (relative tolerance 1e-10).
+     * Data: A given in full storage, or a condensed W, is not symmetric (relative
+     * tolerance 1e-10), or the W formed with a host's solve is not (1e-8).
      */
     FRICONT_ERR_NOT_SYMMETRIC = -203,
     /**
-     * Data: A is not positive definite (the message names the failing pivot's row).
+     * Data: A, or a condensed W, is not positive definite (the message names the failing
+     * pivot's row).
      */
     FRICONT_ERR_NOT_SPD = -204,
     /**
@@ -162,6 +169,13 @@ enum fricont_status
      * `FRICONT_ERR_CALLBACK` (callback code 0).
      */
     FRICONT_ERR_CALLBACK_VALUE = -402,
+    /**
+     * Callback: the host's solve (`fricont_problem_new_solve`) failed: it returned a
+     * negative code, a positive (recoverable) code twice in a row for the same block (it
+     * is retried once), or wrote a NaN or infinite value. Its code is in the message
+     * and, for a path, in `fricont_path_callback_code` (0 for NaN/Inf).
+     */
+    FRICONT_ERR_SOLVE_CALLBACK = -403,
     /**
      * Internal: a panic (a bug in fricont) was caught at the C boundary. The message says
      * where; the handle is poisoned (every later call on it returns
@@ -357,6 +371,23 @@ typedef struct fricont_csr {
      */
     int64_t index_base;
 } fricont_csr;
+
+/**
+ * The host's solve with its stiffness A (see `fricont_problem_new_solve`): overwrite
+ * each of the `ncols` columns of `x` (n rows, column-major, leading dimension
+ * `ldx` ≥ n: entry (i, j) at `x[i + j * ldx]`) with A⁻¹ times it. `user` is the pointer
+ * given to `fricont_problem_new_solve`. Return 0 on success, a positive code for a
+ * recoverable failure (fricont restores the right-hand sides and calls once more), a
+ * negative code for a fatal one (SUNDIALS' convention). Called only from inside
+ * fricont's functions, on the thread that called them (never from a thread of
+ * fricont's own), one call at a time per problem; it must not call fricont functions
+ * that use the same problem.
+ */
+typedef int (*fricont_solve_fn)(void *user,
+                                int64_t n,
+                                int64_t ncols,
+                                double *x,
+                                int64_t ldx);
 
 /**
  * A basis-weights callback for `f(α) = Σ_j φ_j(α) f_j`: writes `φ_j(α)` into `phi[0..k)`
@@ -636,6 +667,83 @@ fricont_status fricont_problem_new(const struct fricont_csr *a,
                                    struct fricont_problem **out);
 
 /**
+ * Creates a problem from condensed data: the Delassus operator W = B A⁻¹ Bᵀ of the
+ * caller's stiffness A and contact matrices B = [N; T] (for example the Schur complement
+ * a distributed direct solver computes, see the README's "Distributed hosts"). fricont
+ * never sees A, N or T.
+ *
+ * * `p`: the number of contact nodes, ≥ 1.
+ * * `w`: W, 2p × 2p, column-major with leading dimension `ldw` ≥ 2p (entry (i, j) at
+ *   `w[i + j * ldw]`, 0-based): rows and columns 0..p are the normal rows of B (N),
+ *   p..2p the tangential ones (T), in the caller's units (length per force). Symmetric
+ *   (relative tolerance 1e-10; the mean of both triangles is used) and positive
+ *   definite. Read during the call and copied; not NULL.
+ * * `out`: receives the new handle (NULL on failure). Not NULL.
+ *
+ * Loads are then given condensed: every load vector (`fricont_path_new_affine`'s f0, f1,
+ * the basis vectors, what a general callback writes) has 2p entries, q = B A⁻¹ f, in the
+ * same row order as W. The gap, friction and r setters work as for
+ * `fricont_problem_new` (the gap in the length units of N u). States carry no
+ * displacement: pass `u = NULL` in `fricont_state` (a non-NULL u gives
+ * `FRICONT_ERR_UNAVAILABLE`), and `fricont_problem_dims` reports n = 0. The residual of a
+ * state then checks the contact law against d = q + W λ only.
+ *
+ * Symmetry and positive definiteness are checked when the problem is built (first
+ * `fricont_problem_build`, `fricont_problem_r` or `fricont_path_new_*`): a non-symmetric
+ * W gives `FRICONT_ERR_NOT_SYMMETRIC`, an indefinite one `FRICONT_ERR_NOT_SPD` with the
+ * failing row and node in the message, a NaN or infinity `FRICONT_ERR_NONFINITE`.
+ *
+ * Returns `FRICONT_OK`; `FRICONT_ERR_NULL` (`w` or `out`); `FRICONT_ERR_LENGTH` (p < 1,
+ * ldw < 2p, or 2p × ldw beyond the address space); `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `w` is NULL or valid for reading `ldw * (2p - 1) + 2p` doubles; `out` is NULL or
+ * valid for one write.
+ */
+fricont_status fricont_problem_new_condensed(int64_t p,
+                                             const double *w,
+                                             int64_t ldw,
+                                             struct fricont_problem **out);
+
+/**
+ * Creates a problem from the contact matrices N and T and the host's own solve with its
+ * stiffness A (n × n, symmetric positive definite; for an FEM code that has A factorised
+ * already). fricont never sees A.
+ *
+ * * `n`: the number of dofs, ≥ 2p.
+ * * `solve`: the host's solve (see `fricont_solve_fn`); not NULL. `user` is passed to
+ *   it unchanged (may be NULL) and must stay valid as long as the problem or any path
+ *   made from it lives.
+ * * `max_block`: the largest number of columns fricont passes in one call (≥ 1; fricont
+ *   uses at most 256).
+ * * `nmat`, `tmat`: N and T (p × n, p ≥ 1), as for `fricont_problem_new`. Not NULL.
+ * * `out`: receives the new handle (NULL on failure). Not NULL.
+ *
+ * Cost: the build forms W = B A⁻¹ Bᵀ by 2p solves (in blocks of `max_block` columns);
+ * each basis load vector costs one solve when a path is made, a general load one solve
+ * per evaluation (two without a derivative), u at a point one solve. Loads are ordinary
+ * (n entries). The residual of a state checks the contact law with d = B u and omits
+ * A u − f − Bᵀ λ (A is unknown). At the build, a W that is not symmetric to 1e-8
+ * relative (a solve that is not that of a symmetric matrix) gives
+ * `FRICONT_ERR_NOT_SYMMETRIC`; a failing solve `FRICONT_ERR_SOLVE_CALLBACK`.
+ *
+ * Returns `FRICONT_OK`; `FRICONT_ERR_NULL` (`solve`, `nmat`, `tmat`, `out`, an array);
+ * `FRICONT_ERR_LENGTH` (n < 2p, N or T not p × n, p = 0, max_block < 1);
+ * `FRICONT_ERR_CSR`; `FRICONT_ERR_NONFINITE`; `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `solve` is NULL or a function as documented; `nmat`, `tmat` as for
+ * `fricont_problem_new`; `out` is NULL or valid for one write.
+ */
+fricont_status fricont_problem_new_solve(int64_t n,
+                                         fricont_solve_fn solve,
+                                         void *user,
+                                         int64_t max_block,
+                                         const struct fricont_csr *nmat,
+                                         const struct fricont_csr *tmat,
+                                         struct fricont_problem **out);
+
+/**
  * Frees a problem handle. NULL is a no-op. Paths created from it stay valid (they hold
  * their own reference to the factorised data). Never use the handle afterwards.
  *
@@ -731,8 +839,8 @@ fricont_status fricont_problem_set_r(struct fricont_problem *problem,
 fricont_status fricont_problem_build(struct fricont_problem *problem);
 
 /**
- * The dimensions: `*n` receives the number of dofs n, `*p` the number of contact nodes
- * p. Each output pointer may be NULL (not written). Does not build.
+ * The dimensions: `*n` receives the number of dofs n (0 for a problem made by
+ * `fricont_problem_new_condensed`), `*p` the number of contact nodes p. Each output pointer may be NULL (not written). Does not build.
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_POISONED`,
  * `FRICONT_ERR_PANIC`.

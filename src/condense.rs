@@ -56,12 +56,129 @@ pub struct SetupTimes {
     pub nnz_l: usize,
 }
 
-/// The Cholesky factor of `A` and the Delassus operator `W = B A⁻¹ Bᵀ`.
+/// Why a host's solve failed: its own code and a message.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SolveFailure {
+    /// The callback's nonzero code: > 0 recoverable (the call is retried once), < 0 fatal.
+    pub code: i32,
+    /// A human-readable reason.
+    pub message: String,
+}
+
+/// The host's solve: overwrites every column of `x` (n rows, column-major) with
+/// `A⁻¹ x`. It is called only from inside fricont's functions, on the thread that called
+/// them, never from a thread of fricont's own; calls are serialised.
+pub type SolveFn = Box<dyn FnMut(MatMut<'_, f64>) -> std::result::Result<(), SolveFailure> + Send>;
+
+/// A host's solve with its block size: fricont never passes more than `max_block`
+/// columns at once. Cloning shares the one callback.
+#[derive(Clone)]
+pub struct HostSolve {
+    f: std::sync::Arc<std::sync::Mutex<SolveFn>>,
+    max_block: usize,
+}
+
+impl std::fmt::Debug for HostSolve {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "HostSolve(max_block = {})", self.max_block)
+    }
+}
+
+impl HostSolve {
+    /// Wraps a solve closure; `max_block` (≥ 1; 0 is taken as 1) bounds the number of
+    /// columns per call.
+    pub fn new(f: SolveFn, max_block: usize) -> Self {
+        Self {
+            f: std::sync::Arc::new(std::sync::Mutex::new(f)),
+            max_block: max_block.max(1),
+        }
+    }
+
+    /// Solves in place, in blocks of at most `max_block` columns; a recoverable failure
+    /// (code > 0) is retried once (on a copy of the right-hand sides), a fatal one (< 0)
+    /// or NaN/Inf in the result is an error.
+    fn solve(&self, mut x: MatMut<'_, f64>) -> Result<()> {
+        thread_local! {
+            /// The solves this thread is inside of (addresses of their callbacks).
+            static ACTIVE: std::cell::RefCell<Vec<usize>> = const { std::cell::RefCell::new(Vec::new()) };
+        }
+        let key = std::sync::Arc::as_ptr(&self.f) as *const () as usize;
+        if ACTIVE.with(|a| a.borrow().contains(&key)) {
+            return Err(Error::HostSolve {
+                code: -1,
+                message: "the solve callback called fricont with its own problem (re-entrant use is not allowed)".into(),
+            });
+        }
+        ACTIVE.with(|a| a.borrow_mut().push(key));
+        let res = self.solve_blocks(x.as_mut());
+        ACTIVE.with(|a| a.borrow_mut().retain(|&k| k != key));
+        res
+    }
+
+    fn solve_blocks(&self, mut x: MatMut<'_, f64>) -> Result<()> {
+        let mut f = self.f.lock().unwrap_or_else(|e| e.into_inner());
+        let k = x.ncols();
+        let mut c0 = 0;
+        while c0 < k {
+            let kb = self.max_block.min(k - c0);
+            let mut xb = x.as_mut().subcols_mut(c0, kb);
+            let rhs = xb.to_owned();
+            let mut res = f(xb.as_mut());
+            if let Err(e) = &res
+                && e.code > 0
+            {
+                xb.copy_from(&rhs);
+                res = f(xb.as_mut());
+            }
+            if let Err(e) = res {
+                return Err(Error::HostSolve {
+                    code: if e.code == 0 { -1 } else { e.code },
+                    message: e.message,
+                });
+            }
+            for c in 0..kb {
+                for i in 0..xb.nrows() {
+                    if !xb[(i, c)].is_finite() {
+                        return Err(Error::HostSolve {
+                            code: 0,
+                            message: format!(
+                                "the solve returned {} in entry {} of column {}",
+                                xb[(i, c)],
+                                i + 1,
+                                c0 + c + 1
+                            ),
+                        });
+                    }
+                }
+            }
+            c0 += kb;
+        }
+        Ok(())
+    }
+}
+
+/// How `A⁻¹` is applied.
+#[derive(Debug)]
+#[allow(clippy::large_enum_variant)] // one per problem
+enum Operator {
+    /// fricont's own sparse Cholesky factor of A.
+    Cholesky {
+        symbolic: SymbolicCholesky<usize>,
+        l_values: Vec<f64>,
+    },
+    /// The host's solve.
+    Host(HostSolve),
+    /// Condensed input: no A⁻¹ at all. Loads are given condensed (2p entries); row k is
+    /// divided by `row_scale[k]` (the node's equilibration).
+    Condensed { row_scale: Vec<f64> },
+}
+
+/// The Delassus operator `W = B A⁻¹ Bᵀ` and the means to apply `A⁻¹`: fricont's own
+/// Cholesky factor of `A`, a host's solve, or nothing (condensed input).
 #[derive(Debug)]
 pub struct Delassus {
     n: usize,
-    symbolic: SymbolicCholesky<usize>,
-    l_values: Vec<f64>,
+    op: Operator,
     b: CsrMatrix,
     w: Mat<f64>,
     trailing: bool,
@@ -155,8 +272,7 @@ impl Delassus {
         }
         let mut this = Self {
             n,
-            symbolic,
-            l_values,
+            op: Operator::Cholesky { symbolic, l_values },
             b: b.clone(),
             w: Mat::zeros(0, 0),
             trailing: false,
@@ -164,14 +280,17 @@ impl Delassus {
         };
         this.times.analyse_s = analyse_s;
         this.times.factorise_s = t_factorise.elapsed().as_secs_f64();
-        this.times.nnz_l = this.l_values.len();
+        this.times.nnz_l = match &this.op {
+            Operator::Cholesky { l_values, .. } => l_values.len(),
+            _ => 0,
+        };
         let t_w = std::time::Instant::now();
         this.w = match trailing.then(|| this.w_by_trailing_block(s)).flatten() {
             Some(w) => {
                 this.trailing = true;
                 w
             }
-            None => this.w_by_solves(),
+            None => this.w_by_solves()?,
         };
         this.check_w()?;
         this.times.w_s = t_w.elapsed().as_secs_f64();
@@ -184,16 +303,19 @@ impl Delassus {
     fn w_by_trailing_block(&self, s: usize) -> Option<Mat<f64>> {
         let n = self.n;
         let m = self.b.nrows();
-        let SymbolicCholeskyRaw::Supernodal(sym) = self.symbolic.raw() else {
+        let Operator::Cholesky { symbolic, l_values } = &self.op else {
             return None;
         };
-        let inv = self.symbolic.perm()?.arrays().1;
+        let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
+            return None;
+        };
+        let inv = symbolic.perm()?.arrays().1;
         let first = n - s;
         // Every dof B touches must sit in the trailing block.
         if self.b.col_idx().iter().any(|&j| inv[j] < first) {
             return None;
         }
-        let llt = SupernodalLltRef::<'_, usize, f64>::new(sym, &self.l_values);
+        let llt = SupernodalLltRef::<'_, usize, f64>::new(sym, l_values);
         let mut lss = Mat::<f64>::zeros(s, s);
         for k in 0..sym.n_supernodes() {
             let node = llt.supernode(k);
@@ -240,14 +362,22 @@ impl Delassus {
 
     /// `W = B A⁻¹ Bᵀ` by 2p solves with the factor of A, in blocks of columns: how W is
     /// formed when B's rows are wide, and an independent check of the trailing-block W
-    /// (the two agree to rounding: ~1e-13 relative).
-    pub fn w_by_solves(&self) -> Mat<f64> {
+    /// (the two agree to rounding: ~1e-13 relative). Errors: a host's solve failed;
+    /// [`Error::NoDisplacement`] for condensed input (no A⁻¹).
+    pub fn w_by_solves(&self) -> Result<Mat<f64>> {
+        let mut w = self.w_by_solves_raw(BLOCK)?;
+        symmetrise(&mut w);
+        Ok(w)
+    }
+
+    /// `B A⁻¹ Bᵀ` by solves with `block` columns at a time, not symmetrised.
+    fn w_by_solves_raw(&self, block: usize) -> Result<Mat<f64>> {
         let m = self.b.nrows();
         let mut w = Mat::<f64>::zeros(m, m);
-        let mut x = Mat::<f64>::zeros(self.n, BLOCK.min(m));
+        let mut x = Mat::<f64>::zeros(self.n, block.min(m));
         let mut col0 = 0;
         while col0 < m {
-            let k = BLOCK.min(m - col0);
+            let k = block.min(m - col0);
             let mut xb = x.as_mut().subcols_mut(0, k);
             xb.fill(0.0);
             for c in 0..k {
@@ -255,7 +385,7 @@ impl Delassus {
                     xb[(j, c)] = v;
                 }
             }
-            self.solve_mat_in_place(xb.as_mut());
+            self.solve_mat_in_place(xb.as_mut())?;
             for i in 0..m {
                 for c in 0..k {
                     w[(i, col0 + c)] = self.b.row(i).map(|(j, v)| v * xb[(j, c)]).sum();
@@ -263,8 +393,7 @@ impl Delassus {
             }
             col0 += k;
         }
-        symmetrise(&mut w);
-        w
+        Ok(w)
     }
 
     fn check_w(&self) -> Result<()> {
@@ -308,7 +437,7 @@ impl Delassus {
         Ok(())
     }
 
-    /// Number of dofs `n`.
+    /// Number of dofs `n` (0 for condensed input).
     pub fn n(&self) -> usize {
         self.n
     }
@@ -341,42 +470,139 @@ impl Delassus {
         m as f64 / tr
     }
 
-    /// Solves `A X = X` in place for every column of `x` (n rows).
-    pub fn solve_mat_in_place(&self, x: MatMut<'_, f64>) {
-        let par = Par::Seq;
-        let k = x.ncols();
-        let mut mem = MemBuffer::new(self.symbolic.solve_in_place_scratch::<f64>(k, par));
-        LltRef::new(&self.symbolic, &self.l_values).solve_in_place_with_conj(
-            Conj::No,
-            x,
-            par,
-            MemStack::new(&mut mem),
-        );
+    /// True when `A⁻¹` can be applied (fricont's factor or a host's solve): u is then
+    /// available; false for condensed input.
+    pub fn has_solve(&self) -> bool {
+        !matches!(self.op, Operator::Condensed { .. })
     }
 
-    /// Solves `A x = x` in place (x has n entries).
-    pub fn solve_in_place(&self, x: &mut [f64]) {
+    /// True for condensed input (W given, loads given condensed).
+    pub fn is_condensed(&self) -> bool {
+        matches!(self.op, Operator::Condensed { .. })
+    }
+
+    /// Length of a load vector: n, or 2p for condensed input.
+    pub fn load_len(&self) -> usize {
+        if self.is_condensed() {
+            self.w.nrows()
+        } else {
+            self.n
+        }
+    }
+
+    /// Solves `A X = X` in place for every column of `x` (n rows). Errors: the host's
+    /// solve failed ([`Error::HostSolve`]); condensed input ([`Error::NoDisplacement`]).
+    pub fn solve_mat_in_place(&self, x: MatMut<'_, f64>) -> Result<()> {
+        match &self.op {
+            Operator::Cholesky { symbolic, l_values } => {
+                let par = Par::Seq;
+                let k = x.ncols();
+                let mut mem = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(k, par));
+                LltRef::new(symbolic, l_values).solve_in_place_with_conj(
+                    Conj::No,
+                    x,
+                    par,
+                    MemStack::new(&mut mem),
+                );
+                Ok(())
+            }
+            Operator::Host(h) => h.solve(x),
+            Operator::Condensed { .. } => Err(no_displacement()),
+        }
+    }
+
+    /// Solves `A x = x` in place (x has n entries). Errors as [`Self::solve_mat_in_place`].
+    pub fn solve_in_place(&self, x: &mut [f64]) -> Result<()> {
         let n = x.len();
         let mat = faer::MatMut::from_column_major_slice_mut(x, n, 1);
-        self.solve_mat_in_place(mat);
+        self.solve_mat_in_place(mat)
     }
 
-    /// `q = B A⁻¹ f` (2p entries) for a load vector `f` (n entries).
-    pub fn condense(&self, f: &[f64]) -> Vec<f64> {
+    /// `q = B A⁻¹ f` (2p entries, equilibrated rows) for a load vector `f` (n entries);
+    /// for condensed input `f` is already `q` in the caller's rows, and only the
+    /// equilibration is applied. Errors: the host's solve failed.
+    pub fn condense(&self, f: &[f64]) -> Result<Vec<f64>> {
+        if let Operator::Condensed { row_scale } = &self.op {
+            return Ok(f.iter().zip(row_scale).map(|(v, s)| v / s).collect());
+        }
         let mut x = f.to_vec();
-        self.solve_in_place(&mut x);
+        self.solve_in_place(&mut x)?;
         let mut q = vec![0.0; self.b.nrows()];
         self.b.mul_vec(&x, &mut q);
-        q
+        Ok(q)
     }
 
-    /// The displacement `u = A⁻¹ (f + Bᵀ λ)` (one back-solve).
-    pub fn displacement(&self, f: &[f64], lambda: &[f64]) -> Vec<f64> {
+    /// The displacement `u = A⁻¹ (f + Bᵀ λ)` (one back-solve). Errors as
+    /// [`Self::solve_mat_in_place`].
+    pub fn displacement(&self, f: &[f64], lambda: &[f64]) -> Result<Vec<f64>> {
         let mut x = f.to_vec();
         self.b.mul_t_vec_add(lambda, &mut x);
-        self.solve_in_place(&mut x);
-        x
+        self.solve_in_place(&mut x)?;
+        Ok(x)
     }
+
+    /// Forms W from a host's solve: `W = B X`, `X = A⁻¹ Bᵀ` by 2p solves in blocks of the
+    /// host's `max_block` columns. `b` is the equilibrated `B` (2p×n). Errors: the solve
+    /// failed; W not symmetric (relative 1e-8: the solve is not that of a symmetric A);
+    /// B rank-deficient.
+    pub fn from_host_solve(n: usize, solve: HostSolve, b: &CsrMatrix) -> Result<Self> {
+        let t_w = std::time::Instant::now();
+        let mut this = Self {
+            n,
+            op: Operator::Host(solve),
+            b: b.clone(),
+            w: Mat::zeros(0, 0),
+            trailing: false,
+            times: SetupTimes::default(),
+        };
+        let m = b.nrows();
+        let block = match &this.op {
+            Operator::Host(h) => h.max_block.clamp(1, 256),
+            _ => BLOCK,
+        };
+        let mut w = this.w_by_solves_raw(block)?;
+        let big = (0..m).fold(0.0f64, |a, i| a.max(w[(i, i)].abs()));
+        for i in 0..m {
+            for j in 0..i {
+                let d = (w[(i, j)] - w[(j, i)]).abs();
+                if d > 1e-8 * big {
+                    return Err(Error::NotSymmetric(format!(
+                        "W = B A^-1 B^T formed with the host's solve is not symmetric: W({}, {}) and W({}, {}) differ by {d:e} (max |W_ii| = {big:e}); is the solve that of a symmetric A?",
+                        i + 1,
+                        j + 1,
+                        j + 1,
+                        i + 1
+                    )));
+                }
+            }
+        }
+        symmetrise(&mut w);
+        this.w = w;
+        this.check_w()?;
+        this.times.w_s = t_w.elapsed().as_secs_f64();
+        Ok(this)
+    }
+
+    /// Condensed input: `w` is the caller's W (2p×2p) already divided symmetrically by
+    /// the node scales (`row_scale`, 2p entries: node i's scale in rows i and p + i), and
+    /// checked to be symmetric and positive definite by the caller.
+    pub(crate) fn from_condensed(w: Mat<f64>, row_scale: Vec<f64>) -> Self {
+        Self {
+            n: 0,
+            op: Operator::Condensed { row_scale },
+            b: CsrMatrix::from_triplets("B", w.nrows(), 0, &[]).expect("an empty matrix"),
+            w,
+            trailing: false,
+            times: SetupTimes::default(),
+        }
+    }
+}
+
+fn no_displacement() -> Error {
+    Error::NoDisplacement(
+        "u is not available: the problem was made from condensed data (W) without a solve with A"
+            .into(),
+    )
 }
 
 /// Replaces `w` by `(w + wᵀ) / 2` (the rounding of a product is not symmetric).

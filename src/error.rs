@@ -16,8 +16,9 @@ pub enum Error {
     /// A NaN or infinite value in the input.
     #[error("non-finite value: {0}")]
     NonFinite(String),
-    /// The stiffness matrix is not symmetric (full storage given).
-    #[error("A is not symmetric: {0}")]
+    /// A matrix that must be symmetric is not: A in full storage, a condensed W, or the
+    /// W formed by a host's solve. The message names the matrix and the entries.
+    #[error("{0}")]
     NotSymmetric(String),
     /// The Cholesky factorisation of A met a non-positive pivot.
     #[error(
@@ -29,6 +30,23 @@ pub enum Error {
         /// Row of A (0-based) that the pivot belongs to.
         row: usize,
     },
+    /// A condensed operator W given by the caller is not positive definite (the message
+    /// names the failing pivot's row and node).
+    #[error("W is not positive definite: {0}")]
+    WNotSpd(String),
+    /// The host's solve callback failed: a fatal code (< 0), or a recoverable one (> 0)
+    /// twice in a row (it is retried once), or NaN/Inf in what it returned (code 0).
+    #[error("the host's solve callback failed (code {code}): {message}")]
+    HostSolve {
+        /// The callback's own nonzero return code (0 when it returned non-finite values).
+        code: i32,
+        /// What went wrong.
+        message: String,
+    },
+    /// The displacement u was asked of a problem that cannot compute it (condensed input
+    /// without a solve).
+    #[error("{0}")]
+    NoDisplacement(String),
     /// B = [N; T] does not have full row rank: W is not positive definite.
     #[error("B = [N; T] is rank-deficient (W = B A^-1 B^T not positive definite): {0}")]
     RankDeficient(String),

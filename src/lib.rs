@@ -56,7 +56,11 @@ pub mod problem;
 pub mod solve;
 
 pub use class::Class;
+pub use condense::{HostSolve, SolveFailure, SolveFn};
 pub use error::{Error, Result};
+/// The faer version fricont is built with (W of [`ProblemBuilder::condensed`] and the
+/// blocks of a [`HostSolve`] are faer matrices).
+pub use faer;
 pub use load::Load;
 pub use path::{EndReason, Event, Path, PathOptions, PieceRecord, Solution, StepOutcome};
 pub use problem::{CsrMatrix, Problem, ProblemBuilder, Storage};

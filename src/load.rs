@@ -162,12 +162,16 @@ pub(crate) struct BoundLoad {
 
 impl BoundLoad {
     pub(crate) fn new(load: Load, del: &Delassus) -> Result<Self> {
-        if load.n() != del.n() {
-            return Err(Error::Dimension(format!(
-                "the load has {} entries, A has n = {}",
-                load.n(),
-                del.n()
-            )));
+        if load.n() != del.load_len() {
+            return Err(Error::Dimension(if del.is_condensed() {
+                format!(
+                    "the load has {} entries; a condensed problem takes condensed loads of 2p = {} entries",
+                    load.n(),
+                    del.load_len()
+                )
+            } else {
+                format!("the load has {} entries, A has n = {}", load.n(), del.n())
+            }));
         }
         let vectors: Vec<&Vec<f64>> = match &load {
             Load::Affine { f0, f1 } => vec![f0, f1],
@@ -179,7 +183,10 @@ impl BoundLoad {
         } else {
             0
         };
-        let q_basis = vectors.into_iter().map(|v| del.condense(v)).collect();
+        let q_basis = vectors
+            .into_iter()
+            .map(|v| del.condense(v))
+            .collect::<Result<_>>()?;
         Ok(Self {
             load,
             q_basis,
@@ -337,12 +344,12 @@ impl BoundLoad {
                 let n = *n;
                 let mut fv = vec![0.0; n];
                 call_vector(f, alpha, &mut fv, "f")?;
-                let q = del.condense(&fv);
+                let q = del.condense(&fv)?;
                 let dq = match df {
                     Some(df) => {
                         let mut d = vec![0.0; n];
                         call_vector(df, alpha, &mut d, "f'")?;
-                        del.condense(&d)
+                        del.condense(&d)?
                     }
                     None => {
                         let h = f64::EPSILON.cbrt() * alpha.abs().max(1.0);
@@ -355,7 +362,7 @@ impl BoundLoad {
                             .zip(&fm)
                             .map(|(a, b)| (a - b) / (2.0 * h))
                             .collect();
-                        del.condense(&d)
+                        del.condense(&d)?
                     }
                 };
                 Ok((q, dq))

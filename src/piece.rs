@@ -483,33 +483,56 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// The scale is the largest magnitude among the terms of the equations, taken entry by
 /// entry (`|A||u|` rather than `A u`), as in a normwise backward error: it is what
 /// rounding errors are proportional to, and it does not depend on the units of u or f.
+///
+/// Without A (a host's solve, or condensed input) H1 is not evaluated. With a host's
+/// solve `B u` comes from its u; for condensed input (u empty, `f` the condensed load q)
+/// `B u = q + W λ`, with `|q| + |W||λ|` as its terms' magnitude.
 pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
     let (n, p, r) = (problem.n(), problem.p(), problem.r());
     let mut h = 0.0f64;
     let mut scale = 1e-300f64;
-    let mut btl = vec![0.0; n];
-    let mut btl_abs = vec![0.0; n];
-    for (i, &l) in lam.iter().enumerate() {
-        for (j, v) in problem.b().row(i) {
-            btl[j] += v * l;
-            btl_abs[j] += (v * l).abs();
-        }
-    }
-    for i in 0..n {
-        let (mut au, mut au_abs) = (0.0, 0.0);
-        for (j, v) in problem.a().row(i) {
-            au += v * u[j];
-            au_abs += (v * u[j]).abs();
-        }
-        h = h.max((au - f[i] - btl[i]).abs());
-        scale = scale.max(au_abs).max(f[i].abs()).max(btl_abs[i]);
-    }
     let mut bu = vec![0.0; 2 * p];
     let mut bu_abs = vec![0.0; 2 * p];
-    for i in 0..2 * p {
-        for (j, v) in problem.b().row(i) {
-            bu[i] += v * u[j];
-            bu_abs[i] += (v * u[j]).abs();
+    if u.is_empty() {
+        // Condensed: B u = q + W λ.
+        let w = problem.delassus().w();
+        let q = problem
+            .delassus()
+            .condense(f)
+            .unwrap_or_else(|_| vec![f64::NAN; 2 * p]);
+        for i in 0..2 * p {
+            bu[i] = q[i];
+            bu_abs[i] = q[i].abs();
+            for (j, &l) in lam.iter().enumerate() {
+                bu[i] += w[(i, j)] * l;
+                bu_abs[i] += (w[(i, j)] * l).abs();
+            }
+        }
+    } else {
+        for i in 0..2 * p {
+            for (j, v) in problem.b().row(i) {
+                bu[i] += v * u[j];
+                bu_abs[i] += (v * u[j]).abs();
+            }
+        }
+    }
+    if let Some(a) = problem.a() {
+        let mut btl = vec![0.0; n];
+        let mut btl_abs = vec![0.0; n];
+        for (i, &l) in lam.iter().enumerate() {
+            for (j, v) in problem.b().row(i) {
+                btl[j] += v * l;
+                btl_abs[j] += (v * l).abs();
+            }
+        }
+        for i in 0..n {
+            let (mut au, mut au_abs) = (0.0, 0.0);
+            for (j, v) in a.row(i) {
+                au += v * u[j];
+                au_abs += (v * u[j]).abs();
+            }
+            h = h.max((au - f[i] - btl[i]).abs());
+            scale = scale.max(au_abs).max(f[i].abs()).max(btl_abs[i]);
         }
     }
     for i in 0..p {
@@ -526,7 +549,7 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
             .max(r * bu_abs[p + i])
             .max(r * g.abs());
     }
-    h / scale
+    if h.is_nan() { f64::INFINITY } else { h / scale }
 }
 
 #[cfg(test)]

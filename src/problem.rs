@@ -5,8 +5,9 @@
 //! [`crate::condense`]); it is `Send + Sync` and is meant to be shared (`Arc<Problem>`) by
 //! any number of [`crate::path::Path`]s.
 
-use crate::condense::Delassus;
+use crate::condense::{Delassus, HostSolve};
 use crate::error::{Error, Result};
+use faer::Mat;
 
 /// A sparse matrix in compressed sparse row form, 0-based, validated: row pointers start
 /// at 0 and do not decrease, column indices are in range, sorted and unique within each
@@ -311,14 +312,37 @@ pub enum Storage {
     Upper,
 }
 
+/// Where the operator `A⁻¹` and `W` come from.
+#[derive(Debug, Clone)]
+enum Source {
+    /// A, N, T: fricont factorises A.
+    Matrix {
+        a: CsrMatrix,
+        storage: Storage,
+        n: CsrMatrix,
+        t: CsrMatrix,
+    },
+    /// N, T and the host's solve with A.
+    Solve {
+        n_dofs: usize,
+        solve: HostSolve,
+        n: CsrMatrix,
+        t: CsrMatrix,
+    },
+    /// The caller's W; loads are given condensed.
+    Condensed { w: Mat<f64> },
+}
+
 /// Builder for a [`Problem`]. Every setter only records; [`ProblemBuilder::build`]
 /// validates everything and factorises.
+///
+/// Three sources, from the most to the least that fricont does itself:
+/// [`ProblemBuilder::new`] (A, N, T: fricont factorises A), [`ProblemBuilder::with_solve`]
+/// (N, T and the host's own solve with A) and [`ProblemBuilder::condensed`] (the host's
+/// W; no displacement).
 #[derive(Debug, Clone)]
 pub struct ProblemBuilder {
-    a: CsrMatrix,
-    storage: Storage,
-    n: CsrMatrix,
-    t: CsrMatrix,
+    source: Source,
     friction: Vec<f64>,
     gap: Option<Vec<f64>>,
     r: Option<f64>,
@@ -331,16 +355,43 @@ impl ProblemBuilder {
     /// Friction defaults to 0 (frictionless), the gap to 0, `r` to the default of
     /// [`Problem::default_r`].
     pub fn new(a: CsrMatrix, storage: Storage, n: CsrMatrix, t: CsrMatrix) -> Self {
-        Self {
-            a,
-            storage,
+        Self::from_source(Source::Matrix { a, storage, n, t })
+    }
+
+    /// Starts a problem from the contact matrices `N`, `T` (p×n) and the host's own solve
+    /// with A (n×n symmetric positive definite, which fricont never sees): `solve`
+    /// overwrites a block of right-hand sides with `A⁻¹` times them. At the build, W is
+    /// formed by 2p solves (in blocks of the solve's `max_block` columns); each load
+    /// vector costs one solve (a general load one or two per evaluation) and u at a point
+    /// one solve. The residual of reported states then omits `A u − f − Bᵀλ` (A is not
+    /// known). Loads are ordinary (n entries).
+    pub fn with_solve(n_dofs: usize, solve: HostSolve, n: CsrMatrix, t: CsrMatrix) -> Self {
+        Self::from_source(Source::Solve {
+            n_dofs,
+            solve,
             n,
             t,
+        })
+    }
+
+    /// Starts a problem from condensed data: `w` is the Delassus operator
+    /// `W = B A⁻¹ Bᵀ` (2p×2p, symmetric positive definite; rows and columns `0..p` normal,
+    /// `p..2p` tangential, in the units of the caller's N and T). Loads are then given
+    /// condensed, `q = B A⁻¹ f` (2p entries, the same row order), and the gap in the
+    /// units of `N u`. No displacement is available: states carry an empty u.
+    pub fn condensed(w: Mat<f64>) -> Self {
+        Self::from_source(Source::Condensed { w })
+    }
+
+    fn from_source(source: Source) -> Self {
+        Self {
+            source,
             friction: vec![0.0],
             gap: None,
             r: None,
         }
     }
+
     /// Friction coefficient `F ≥ 0` (dimensionless), the same at every node.
     pub fn friction_uniform(mut self, f: f64) -> Self {
         self.friction = vec![f];
@@ -364,43 +415,67 @@ impl ProblemBuilder {
     }
 
     /// Validates the data, factorises `A` (sparse Cholesky, fill-reducing ordering) and
-    /// forms `W = B A⁻¹ Bᵀ`.
+    /// forms `W = B A⁻¹ Bᵀ` (with a host's solve: W by 2p solves; condensed: W checked
+    /// and used as given).
     ///
-    /// Errors: [`Error::Dimension`] (A not square, N/T not p×n, 2p > n, F or g of wrong
-    /// length),
-    /// [`Error::NotSymmetric`], [`Error::Csr`] (entries in the wrong triangle),
-    /// [`Error::NonFinite`], [`Error::NotSpd`] (with the pivot), [`Error::RankDeficient`]
-    /// (B = [N; T] without full row rank 2p), [`Error::InvalidParameter`] (F < 0 or not
+    /// Errors: [`Error::Dimension`] (A not square, N/T not p×n, 2p > n, W not 2p×2p, F or
+    /// g of wrong length),
+    /// [`Error::NotSymmetric`] (A in full storage, the caller's W, or the W of a host's
+    /// solve), [`Error::Csr`] (entries in the wrong triangle),
+    /// [`Error::NonFinite`], [`Error::NotSpd`] (A, with the pivot), [`Error::WNotSpd`] (the
+    /// caller's W, with the pivot), [`Error::RankDeficient`]
+    /// (B = [N; T] without full row rank 2p), [`Error::HostSolve`] (the host's solve
+    /// failed), [`Error::InvalidParameter`] (F < 0 or not
     /// finite, r ≤ 0 or not finite or `r / r0` outside [`R_RANGE`], p = 0).
     pub fn build(self) -> Result<Problem> {
-        let n = self.a.nrows();
-        if self.a.ncols() != n {
-            return Err(Error::Dimension(format!(
-                "A is {}x{}, must be square",
-                n,
-                self.a.ncols()
-            )));
-        }
-        let p = self.n.nrows();
+        let p = match &self.source {
+            Source::Matrix { n, .. } | Source::Solve { n, .. } => n.nrows(),
+            Source::Condensed { w } => {
+                if w.nrows() != w.ncols() || w.nrows() % 2 != 0 {
+                    return Err(Error::Dimension(format!(
+                        "W is {}x{}, must be 2p x 2p",
+                        w.nrows(),
+                        w.ncols()
+                    )));
+                }
+                w.nrows() / 2
+            }
+        };
         if p == 0 {
             return Err(Error::InvalidParameter(
-                "no contact nodes: N has 0 rows (p must be ≥ 1)".into(),
+                "no contact nodes: p must be ≥ 1 (N has 0 rows, or W is empty)".into(),
             ));
         }
-        for (name, m) in [("N", &self.n), ("T", &self.t)] {
-            if m.nrows() != p || m.ncols() != n {
+        let n_dofs = match &self.source {
+            Source::Matrix { a, .. } => {
+                if a.ncols() != a.nrows() {
+                    return Err(Error::Dimension(format!(
+                        "A is {}x{}, must be square",
+                        a.nrows(),
+                        a.ncols()
+                    )));
+                }
+                a.nrows()
+            }
+            Source::Solve { n_dofs, .. } => *n_dofs,
+            Source::Condensed { .. } => 0,
+        };
+        if let Source::Matrix { n, t, .. } | Source::Solve { n, t, .. } = &self.source {
+            for (name, m) in [("N", n), ("T", t)] {
+                if m.nrows() != p || m.ncols() != n_dofs {
+                    return Err(Error::Dimension(format!(
+                        "{name} is {}x{}, expected p x n = {p}x{n_dofs} (p from the rows of N, n from A)",
+                        m.nrows(),
+                        m.ncols()
+                    )));
+                }
+            }
+            if 2 * p > n_dofs {
                 return Err(Error::Dimension(format!(
-                    "{name} is {}x{}, expected p x n = {p}x{n} (p from the rows of N, n from A)",
-                    m.nrows(),
-                    m.ncols()
+                    "2p = {} exceeds n = {n_dofs}, so B = [N; T] cannot have full row rank",
+                    2 * p
                 )));
             }
-        }
-        if 2 * p > n {
-            return Err(Error::Dimension(format!(
-                "2p = {} exceeds n = {n}, so B = [N; T] cannot have full row rank",
-                2 * p
-            )));
         }
         let friction = match self.friction.len() {
             1 => vec![self.friction[0]; p],
@@ -443,35 +518,34 @@ impl ProblemBuilder {
                 "r = {r}, must be finite and > 0"
             )));
         }
-        let (lower, full_a) = lower_and_full(&self.a, self.storage)?;
-        // Equilibration: node i's rows N_i, T_i and gap g_i divided by
-        // s_i = max(‖N_i‖₂, ‖T_i‖₂). The problem is invariant under such a per-node
-        // scaling (λ_i scales by s_i), and with unit rows no node's forces are measured on
-        // another node's scale.
-        let row_norm = |m: &CsrMatrix, i: usize| m.row(i).map(|(_, v)| v * v).sum::<f64>().sqrt();
-        let node_scale: Vec<f64> = (0..p)
-            .map(|i| {
-                let s = row_norm(&self.n, i).max(row_norm(&self.t, i));
-                if s.is_finite() && s > 0.0 { s } else { 1.0 }
-            })
-            .collect();
-        // B = [N; T] as one CSR matrix (2p x n), equilibrated.
-        let mut trip = Vec::with_capacity(self.n.nnz() + self.t.nnz());
-        for i in 0..p {
-            let s = node_scale[i];
-            trip.extend(self.n.row(i).map(|(j, v)| (i, j, v / s)));
-            trip.extend(self.t.row(i).map(|(j, v)| (p + i, j, v / s)));
-        }
+        let (a, b, node_scale, delassus) = match self.source {
+            Source::Matrix { a, storage, n, t } => {
+                let (lower, full_a) = lower_and_full(&a, storage)?;
+                let (b, node_scale) = equilibrated_b(&n, &t, n_dofs)?;
+                let del = Delassus::new(&lower, &b)?;
+                (Some(full_a), b, node_scale, del)
+            }
+            Source::Solve { solve, n, t, .. } => {
+                let (b, node_scale) = equilibrated_b(&n, &t, n_dofs)?;
+                let del = Delassus::from_host_solve(n_dofs, solve, &b)?;
+                (None, b, node_scale, del)
+            }
+            Source::Condensed { w } => {
+                let (w_int, node_scale) = equilibrated_w(w)?;
+                let row_scale = (0..2 * p).map(|k| node_scale[k % p]).collect();
+                let del = Delassus::from_condensed(w_int, row_scale);
+                (None, del.b().clone(), node_scale, del)
+            }
+        };
         let gap_eq: Vec<f64> = gap.iter().zip(&node_scale).map(|(g, s)| g / s).collect();
-        let b = CsrMatrix::from_triplets("B", 2 * p, n, &trip)?;
-        let delassus = std::sync::Arc::new(Delassus::new(&lower, &b)?);
+        let delassus = std::sync::Arc::new(delassus);
         let r_default = delassus.default_r();
         let r = self.r.unwrap_or(r_default);
         check_r(r, r_default)?;
         Ok(Problem {
-            n,
+            n: n_dofs,
             p,
-            a: full_a,
+            a,
             b,
             friction,
             gap,
@@ -482,6 +556,109 @@ impl ProblemBuilder {
             delassus,
         })
     }
+}
+
+/// Equilibration: node i's rows N_i, T_i (and gap g_i) divided by
+/// `s_i = max(‖N_i‖₂, ‖T_i‖₂)`. The problem is invariant under such a per-node scaling
+/// (λ_i scales by s_i), and with unit rows no node's forces are measured on another
+/// node's scale. Returns `B = [N; T] / s` (2p×n) and the scales.
+fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMatrix, Vec<f64>)> {
+    let p = n.nrows();
+    let row_norm = |m: &CsrMatrix, i: usize| m.row(i).map(|(_, v)| v * v).sum::<f64>().sqrt();
+    let node_scale: Vec<f64> = (0..p)
+        .map(|i| {
+            let s = row_norm(n, i).max(row_norm(t, i));
+            if s.is_finite() && s > 0.0 { s } else { 1.0 }
+        })
+        .collect();
+    let mut trip = Vec::with_capacity(n.nnz() + t.nnz());
+    for (i, &s) in node_scale.iter().enumerate() {
+        trip.extend(n.row(i).map(|(j, v)| (i, j, v / s)));
+        trip.extend(t.row(i).map(|(j, v)| (p + i, j, v / s)));
+    }
+    Ok((
+        CsrMatrix::from_triplets("B", 2 * p, n_dofs, &trip)?,
+        node_scale,
+    ))
+}
+
+/// Checks a caller's W (finite, symmetric to 1e-10 relative, positive definite with a
+/// relative pivot above 1e-12) and equilibrates it as [`equilibrated_b`] would the rows of
+/// B: `s_i = sqrt(max(W_ii, W_{p+i,p+i}))` (node i's rows of B in the A⁻¹ norm), so the
+/// internal W has node diagonals ≤ 1. Returns `S⁻¹ W S⁻¹` and the scales.
+fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
+    let m = w.nrows();
+    let p = m / 2;
+    let name = |i: usize| {
+        if i < p {
+            format!("row {} (normal, node {})", i + 1, i + 1)
+        } else {
+            format!("row {} (tangential, node {})", i + 1, i - p + 1)
+        }
+    };
+    let mut big = 0.0f64;
+    for j in 0..m {
+        for i in 0..m {
+            let v = w[(i, j)];
+            if !v.is_finite() {
+                return Err(Error::NonFinite(format!(
+                    "W({}, {}) (1-based) is {v}",
+                    i + 1,
+                    j + 1
+                )));
+            }
+            big = big.max(v.abs());
+        }
+    }
+    for j in 0..m {
+        for i in j + 1..m {
+            let d = (w[(i, j)] - w[(j, i)]).abs();
+            if d > 1e-10 * big {
+                return Err(Error::NotSymmetric(format!(
+                    "W is not symmetric: W({}, {}) and W({}, {}) differ by {d:e} (tolerance 1e-10 * max|W| = {:e})",
+                    i + 1,
+                    j + 1,
+                    j + 1,
+                    i + 1,
+                    1e-10 * big
+                )));
+            }
+        }
+    }
+    if let Some(i) = (0..m).find(|&i| w[(i, i)] <= 0.0) {
+        return Err(Error::WNotSpd(format!(
+            "{} has the diagonal entry W({}, {}) = {:e} ≤ 0",
+            name(i),
+            i + 1,
+            i + 1,
+            w[(i, i)]
+        )));
+    }
+    let node_scale: Vec<f64> = (0..p)
+        .map(|i| w[(i, i)].max(w[(p + i, p + i)]).sqrt())
+        .collect();
+    let sc = |k: usize| node_scale[k % p];
+    let w_int = Mat::<f64>::from_fn(m, m, |i, j| 0.5 * (w[(i, j)] + w[(j, i)]) / (sc(i) * sc(j)));
+    let pivot_err = |j: usize, d: f64| {
+        Error::WNotSpd(format!(
+            "the Cholesky factorisation of W fails at {} (relative pivot {d:e}; W must be symmetric positive definite: is B = [N; T] of full row rank?)",
+            name(j)
+        ))
+    };
+    let llt = match w_int.llt(faer::Side::Lower) {
+        Ok(llt) => llt,
+        Err(faer::linalg::cholesky::llt::factor::LltError::NonPositivePivot { index }) => {
+            return Err(pivot_err(index.min(m - 1), 0.0));
+        }
+    };
+    let l = llt.L();
+    for j in 0..m {
+        let d = l[(j, j)] * l[(j, j)] / w_int[(j, j)];
+        if d <= 1e-12 {
+            return Err(pivot_err(j, d));
+        }
+    }
+    Ok((w_int, node_scale))
 }
 
 /// Lower triangle (row ≥ col) and full storage of A, checking the storage convention and,
@@ -543,7 +720,7 @@ fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatr
                     };
                     if d.abs() > tol {
                         return Err(Error::NotSymmetric(format!(
-                            "A({}, {}) and A({}, {}) differ by {:e} (tolerance 1e-10 * max|A| = {:e}); pass lower or upper storage if only one triangle is meant",
+                            "A is not symmetric: A({}, {}) and A({}, {}) differ by {:e} (tolerance 1e-10 * max|A| = {:e}); pass lower or upper storage if only one triangle is meant",
                             i + 1,
                             c + 1,
                             c + 1,
@@ -644,7 +821,7 @@ fn check_r(r: f64, r_default: f64) -> Result<()> {
 pub struct Problem {
     n: usize,
     p: usize,
-    a: CsrMatrix,
+    a: Option<CsrMatrix>,
     b: CsrMatrix,
     friction: Vec<f64>,
     /// The gap as given.
@@ -658,25 +835,41 @@ pub struct Problem {
 }
 
 impl Problem {
-    /// Number of displacement dofs `n`.
+    /// Number of displacement dofs `n` (0 for a problem made from condensed data).
     pub fn n(&self) -> usize {
         self.n
+    }
+    /// True when u can be computed (fricont's factor of A or a host's solve); false for a
+    /// problem made from condensed data.
+    pub fn has_displacement(&self) -> bool {
+        self.delassus.has_solve()
+    }
+    /// True for a problem made from condensed data ([`ProblemBuilder::condensed`]): loads
+    /// are condensed vectors of 2p entries.
+    pub fn is_condensed(&self) -> bool {
+        self.delassus.is_condensed()
+    }
+    /// Length of the load vectors: n, or 2p for a problem made from condensed data.
+    pub fn load_len(&self) -> usize {
+        self.delassus.load_len()
     }
     /// Number of contact nodes `p`.
     pub fn p(&self) -> usize {
         self.p
     }
-    /// The stiffness matrix, full storage.
-    pub fn a(&self) -> &CsrMatrix {
-        &self.a
+    /// The stiffness matrix, full storage; None when the problem was made from a host's
+    /// solve or from condensed data.
+    pub fn a(&self) -> Option<&CsrMatrix> {
+        self.a.as_ref()
     }
-    /// The equilibrated `B = [N; T]` (2p×n): rows `0..p` are N, rows `p..2p` are T, node
+    /// The equilibrated `B = [N; T]` (2p×n; 2p×0 for condensed data): rows `0..p` are N, rows `p..2p` are T, node
     /// i's two rows divided by [`Problem::node_scale`]`[i]`. W, the condensed loads and
     /// every internal λ refer to these rows; the path reports λ in the caller's units.
     pub fn b(&self) -> &CsrMatrix {
         &self.b
     }
-    /// The scale `s_i = max(‖N_i‖₂, ‖T_i‖₂)` of each node's rows (1 for an empty row).
+    /// The scale `s_i = max(‖N_i‖₂, ‖T_i‖₂)` of each node's rows (1 for an empty row); for
+    /// condensed data `sqrt(max(W_ii, W_{p+i,p+i}))`.
     /// Internal forces are `s_i λ_i` for the caller's `λ_i`.
     pub fn node_scale(&self) -> &[f64] {
         &self.node_scale

@@ -35,7 +35,7 @@ fn trailing_block_w_equals_w_by_solves_on_the_sample() {
         .unwrap();
     let del = pb.delassus();
     assert!(del.w_from_trailing_block());
-    let d = max_rel_diff(del.w(), del.w_by_solves().as_ref());
+    let d = max_rel_diff(del.w(), del.w_by_solves().unwrap().as_ref());
     assert!(d <= 1e-13, "relative difference {d:e}");
 }
 

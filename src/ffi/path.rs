@@ -253,6 +253,12 @@ impl PathInner {
             return Ok(());
         };
         let (n, p) = (self.n, self.p);
+        if !out.u.is_null() && !self.problem.has_displacement() {
+            return Err(Failure::new(
+                fricont_status::FRICONT_ERR_UNAVAILABLE,
+                "u is not available: the problem was made from condensed data (fricont_problem_new_condensed); pass u = NULL",
+            ));
+        }
         // SAFETY: the caller's buffers are valid for their stated lengths.
         let (u, ln, lt, cl) = unsafe {
             (
@@ -313,10 +319,12 @@ unsafe fn new_path(
     // SAFETY: NULL or live, by contract.
     let prob = unsafe { handle_ref(problem, "problem") }?;
     let (shared, n, p) = prob.shared()?;
-    let load = make_load(n)?;
-    if load.n() != n {
+    // n entries, or 2p condensed ones for a problem made from condensed data.
+    let load_len = shared.load_len();
+    let load = make_load(load_len)?;
+    if load.n() != load_len {
         return Err(Failure::length(format!(
-            "the load has {} entries, the problem has n = {n} dofs",
+            "the load has {} entries, the problem takes {load_len}",
             load.n()
         )));
     }

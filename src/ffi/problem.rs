@@ -1,6 +1,6 @@
 //! The problem handle: A, N, T in CSR, friction, gap, r; factorised once and shared.
 
-use std::ffi::c_char;
+use std::ffi::{c_char, c_int, c_void};
 use std::sync::{Arc, Mutex};
 
 use super::boundary::{
@@ -8,6 +8,7 @@ use super::boundary::{
     write_message,
 };
 use super::status::{fricont_status, fricont_storage};
+use crate::condense::{HostSolve, SolveFailure};
 use crate::problem::{CsrMatrix, Problem, ProblemBuilder, Storage};
 
 /// A sparse matrix in compressed sparse row (CSR) form, as the caller stores it. The
@@ -55,6 +56,7 @@ pub struct fricont_problem {
 }
 
 struct ProblemInner {
+    /// Number of dofs (0 for a problem made from condensed data).
     n: usize,
     p: usize,
     /// The recorded data and settings (taken out and put back by the setters).
@@ -213,18 +215,263 @@ pub unsafe extern "C" fn fricont_problem_new(
                 )));
             }
         }
-        let handle = Box::new(fricont_problem {
-            slot: ErrorSlot::default(),
-            inner: Mutex::new(ProblemInner {
-                n: nd,
-                p,
-                builder: Some(ProblemBuilder::new(am, storage, nm, tm)),
-                built: None,
-            }),
-        });
         // SAFETY: `out` is valid (checked above).
-        unsafe { out.write(Box::into_raw(handle)) };
-        Ok(fricont_status::FRICONT_OK)
+        unsafe { new_handle(out, nd, p, ProblemBuilder::new(am, storage, nm, tm)) }
+    })
+}
+
+/// Writes a new handle for `builder` into `out` (valid, by the callers' contract).
+///
+/// # Safety
+/// `out` is valid for one write.
+unsafe fn new_handle(
+    out: *mut *mut fricont_problem,
+    n: usize,
+    p: usize,
+    builder: ProblemBuilder,
+) -> FfiResult {
+    let handle = Box::new(fricont_problem {
+        slot: ErrorSlot::default(),
+        inner: Mutex::new(ProblemInner {
+            n,
+            p,
+            builder: Some(builder),
+            built: None,
+        }),
+    });
+    // SAFETY: by this function's contract.
+    unsafe { out.write(Box::into_raw(handle)) };
+    Ok(fricont_status::FRICONT_OK)
+}
+
+/// Creates a problem from condensed data: the Delassus operator W = B A⁻¹ Bᵀ of the
+/// caller's stiffness A and contact matrices B = [N; T] (for example the Schur complement
+/// a distributed direct solver computes, see the README's "Distributed hosts"). fricont
+/// never sees A, N or T.
+///
+/// * `p`: the number of contact nodes, ≥ 1.
+/// * `w`: W, 2p × 2p, column-major with leading dimension `ldw` ≥ 2p (entry (i, j) at
+///   `w[i + j * ldw]`, 0-based): rows and columns 0..p are the normal rows of B (N),
+///   p..2p the tangential ones (T), in the caller's units (length per force). Symmetric
+///   (relative tolerance 1e-10; the mean of both triangles is used) and positive
+///   definite. Read during the call and copied; not NULL.
+/// * `out`: receives the new handle (NULL on failure). Not NULL.
+///
+/// Loads are then given condensed: every load vector (`fricont_path_new_affine`'s f0, f1,
+/// the basis vectors, what a general callback writes) has 2p entries, q = B A⁻¹ f, in the
+/// same row order as W. The gap, friction and r setters work as for
+/// `fricont_problem_new` (the gap in the length units of N u). States carry no
+/// displacement: pass `u = NULL` in `fricont_state` (a non-NULL u gives
+/// `FRICONT_ERR_UNAVAILABLE`), and `fricont_problem_dims` reports n = 0. The residual of a
+/// state then checks the contact law against d = q + W λ only.
+///
+/// Symmetry and positive definiteness are checked when the problem is built (first
+/// `fricont_problem_build`, `fricont_problem_r` or `fricont_path_new_*`): a non-symmetric
+/// W gives `FRICONT_ERR_NOT_SYMMETRIC`, an indefinite one `FRICONT_ERR_NOT_SPD` with the
+/// failing row and node in the message, a NaN or infinity `FRICONT_ERR_NONFINITE`.
+///
+/// Returns `FRICONT_OK`; `FRICONT_ERR_NULL` (`w` or `out`); `FRICONT_ERR_LENGTH` (p < 1,
+/// ldw < 2p, or 2p × ldw beyond the address space); `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `w` is NULL or valid for reading `ldw * (2p - 1) + 2p` doubles; `out` is NULL or
+/// valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_new_condensed(
+    p: i64,
+    w: *const f64,
+    ldw: i64,
+    out: *mut *mut fricont_problem,
+) -> fricont_status {
+    ffi_boundary!({
+        if out.is_null() {
+            return Err(Failure::null(
+                "out (the fricont_problem ** receiving the handle)",
+            ));
+        }
+        // SAFETY: `out` is a valid pointer by contract; clear it before any failure.
+        unsafe { out.write(std::ptr::null_mut()) };
+        let pn = len_of(p, "p")?;
+        if pn == 0 {
+            return Err(Failure::length(
+                "p = 0: there must be at least one contact node",
+            ));
+        }
+        let m = 2 * pn;
+        let ld = len_of(ldw, "ldw")?;
+        if ld < m {
+            return Err(Failure::length(format!(
+                "ldw = {ld} is smaller than 2p = {m}"
+            )));
+        }
+        let total = ld
+            .checked_mul(m - 1)
+            .and_then(|v| v.checked_add(m))
+            .filter(|&v| v <= isize::MAX as usize / 8)
+            .ok_or_else(|| {
+                Failure::length(format!(
+                    "W of 2p = {m} columns with ldw = {ld} does not fit in memory"
+                ))
+            })?;
+        // SAFETY: valid for `total` reads by contract.
+        let wv = unsafe { slice_in(w, total, "w") }?;
+        let wm = faer::Mat::<f64>::from_fn(m, m, |i, j| wv[i + j * ld]);
+        // SAFETY: `out` is valid (checked above).
+        unsafe { new_handle(out, 0, pn, ProblemBuilder::condensed(wm)) }
+    })
+}
+
+/// The host's solve with its stiffness A (see `fricont_problem_new_solve`): overwrite
+/// each of the `ncols` columns of `x` (n rows, column-major, leading dimension
+/// `ldx` ≥ n: entry (i, j) at `x[i + j * ldx]`) with A⁻¹ times it. `user` is the pointer
+/// given to `fricont_problem_new_solve`. Return 0 on success, a positive code for a
+/// recoverable failure (fricont restores the right-hand sides and calls once more), a
+/// negative code for a fatal one (SUNDIALS' convention). Called only from inside
+/// fricont's functions, on the thread that called them (never from a thread of
+/// fricont's own), one call at a time per problem; it must not call fricont functions
+/// that use the same problem.
+#[allow(non_camel_case_types)]
+pub type fricont_solve_fn = Option<
+    unsafe extern "C" fn(user: *mut c_void, n: i64, ncols: i64, x: *mut f64, ldx: i64) -> c_int,
+>;
+
+/// The C solve as a Rust closure (user data carried across threads: the host answers for
+/// it, as documented on `fricont_solve_fn`).
+struct CSolve {
+    f: unsafe extern "C" fn(*mut c_void, i64, i64, *mut f64, i64) -> c_int,
+    user: *mut c_void,
+}
+// SAFETY: fricont calls the host's solve only from threads that called into fricont with
+// this problem, one call at a time (a mutex); the host's contract for `user` covers this.
+unsafe impl Send for CSolve {}
+
+impl CSolve {
+    fn call(&self, mut x: faer::MatMut<'_, f64>) -> Result<(), SolveFailure> {
+        let (n, k) = (x.nrows(), x.ncols());
+        let contiguous = x.row_stride() == 1 && x.col_stride() >= n as isize;
+        let code = if contiguous {
+            // SAFETY: `x` addresses k columns of n values with stride `col_stride`; the
+            // host's function is valid by the contract of `fricont_problem_new_solve`.
+            unsafe {
+                (self.f)(
+                    self.user,
+                    n as i64,
+                    k as i64,
+                    x.as_ptr_mut(),
+                    (x.col_stride() as i64).max(1),
+                )
+            }
+        } else {
+            let mut tmp = x.to_owned();
+            let ld = (tmp.col_stride() as i64).max(1);
+            // SAFETY: as above, for the contiguous copy.
+            let c =
+                unsafe { (self.f)(self.user, n as i64, k as i64, tmp.as_mut().as_ptr_mut(), ld) };
+            x.copy_from(&tmp);
+            c
+        };
+        match code {
+            0 => Ok(()),
+            c => Err(SolveFailure {
+                code: c,
+                message: format!(
+                    "the solve returned {c} ({}) for a block of {k} column(s)",
+                    if c > 0 {
+                        "recoverable, retried once"
+                    } else {
+                        "fatal"
+                    }
+                ),
+            }),
+        }
+    }
+}
+
+/// Creates a problem from the contact matrices N and T and the host's own solve with its
+/// stiffness A (n × n, symmetric positive definite; for an FEM code that has A factorised
+/// already). fricont never sees A.
+///
+/// * `n`: the number of dofs, ≥ 2p.
+/// * `solve`: the host's solve (see `fricont_solve_fn`); not NULL. `user` is passed to
+///   it unchanged (may be NULL) and must stay valid as long as the problem or any path
+///   made from it lives.
+/// * `max_block`: the largest number of columns fricont passes in one call (≥ 1; fricont
+///   uses at most 256).
+/// * `nmat`, `tmat`: N and T (p × n, p ≥ 1), as for `fricont_problem_new`. Not NULL.
+/// * `out`: receives the new handle (NULL on failure). Not NULL.
+///
+/// Cost: the build forms W = B A⁻¹ Bᵀ by 2p solves (in blocks of `max_block` columns);
+/// each basis load vector costs one solve when a path is made, a general load one solve
+/// per evaluation (two without a derivative), u at a point one solve. Loads are ordinary
+/// (n entries). The residual of a state checks the contact law with d = B u and omits
+/// A u − f − Bᵀ λ (A is unknown). At the build, a W that is not symmetric to 1e-8
+/// relative (a solve that is not that of a symmetric matrix) gives
+/// `FRICONT_ERR_NOT_SYMMETRIC`; a failing solve `FRICONT_ERR_SOLVE_CALLBACK`.
+///
+/// Returns `FRICONT_OK`; `FRICONT_ERR_NULL` (`solve`, `nmat`, `tmat`, `out`, an array);
+/// `FRICONT_ERR_LENGTH` (n < 2p, N or T not p × n, p = 0, max_block < 1);
+/// `FRICONT_ERR_CSR`; `FRICONT_ERR_NONFINITE`; `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `solve` is NULL or a function as documented; `nmat`, `tmat` as for
+/// `fricont_problem_new`; `out` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_new_solve(
+    n: i64,
+    solve: fricont_solve_fn,
+    user: *mut c_void,
+    max_block: i64,
+    nmat: *const fricont_csr,
+    tmat: *const fricont_csr,
+    out: *mut *mut fricont_problem,
+) -> fricont_status {
+    ffi_boundary!({
+        if out.is_null() {
+            return Err(Failure::null(
+                "out (the fricont_problem ** receiving the handle)",
+            ));
+        }
+        // SAFETY: `out` is a valid pointer by contract; clear it before any failure.
+        unsafe { out.write(std::ptr::null_mut()) };
+        let Some(f) = solve else {
+            return Err(Failure::null("solve (the host's solve function)"));
+        };
+        let nd = len_of(n, "n")?;
+        if max_block < 1 {
+            return Err(Failure::length(format!(
+                "max_block = {max_block}, must be ≥ 1"
+            )));
+        }
+        // SAFETY: by this function's contract.
+        let (nm, tm) = unsafe { (read_csr(nmat, "N")?, read_csr(tmat, "T")?) };
+        let p = nm.nrows();
+        if p == 0 {
+            return Err(Failure::length(
+                "N has 0 rows: there must be at least one contact node",
+            ));
+        }
+        for (name, m) in [("N", &nm), ("T", &tm)] {
+            if m.nrows() != p || m.ncols() != nd {
+                return Err(Failure::length(format!(
+                    "{name} is {}x{}, expected p x n = {p}x{nd} (p from the rows of N, n as given)",
+                    m.nrows(),
+                    m.ncols()
+                )));
+            }
+        }
+        if 2 * p > nd {
+            return Err(Failure::length(format!(
+                "2p = {} exceeds n = {nd}, so B = [N; T] cannot have full row rank",
+                2 * p
+            )));
+        }
+        let cs = CSolve { f, user };
+        let host = HostSolve::new(
+            Box::new(move |x| cs.call(x)),
+            usize::try_from(max_block).unwrap_or(usize::MAX),
+        );
+        // SAFETY: `out` is valid (checked above).
+        unsafe { new_handle(out, nd, p, ProblemBuilder::with_solve(nd, host, nm, tm)) }
     })
 }
 
@@ -423,8 +670,8 @@ pub unsafe extern "C" fn fricont_problem_build(problem: *mut fricont_problem) ->
     })
 }
 
-/// The dimensions: `*n` receives the number of dofs n, `*p` the number of contact nodes
-/// p. Each output pointer may be NULL (not written). Does not build.
+/// The dimensions: `*n` receives the number of dofs n (0 for a problem made by
+/// `fricont_problem_new_condensed`), `*p` the number of contact nodes p. Each output pointer may be NULL (not written). Does not build.
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_POISONED`,
 /// `FRICONT_ERR_PANIC`.

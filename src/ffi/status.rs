@@ -60,15 +60,20 @@ pub enum fricont_status {
     /// started, setting path options after the start, choosing a branch where there is no
     /// bifurcation, starting without an α window).
     FRICONT_ERR_ORDER = -104,
+    /// Usage: the displacement u was asked of a problem that cannot compute it (made by
+    /// `fricont_problem_new_condensed`): pass NULL for u there.
+    FRICONT_ERR_UNAVAILABLE = -105,
     /// Data: a malformed CSR matrix (index base not 0 or 1, row pointer not starting at
     /// the base or decreasing or not ending at the base + nnz, column out of range,
     /// duplicate entry in a row, an entry of A in the wrong triangle for the storage).
     FRICONT_ERR_CSR = -201,
     /// Data: a NaN or infinite value in A, N, T, the gap, a guess or a load vector.
     FRICONT_ERR_NONFINITE = -202,
-    /// Data: A given in full storage is not symmetric (relative tolerance 1e-10).
+    /// Data: A given in full storage, or a condensed W, is not symmetric (relative
+    /// tolerance 1e-10), or the W formed with a host's solve is not (1e-8).
     FRICONT_ERR_NOT_SYMMETRIC = -203,
-    /// Data: A is not positive definite (the message names the failing pivot's row).
+    /// Data: A, or a condensed W, is not positive definite (the message names the failing
+    /// pivot's row).
     FRICONT_ERR_NOT_SPD = -204,
     /// Data: B = [N; T] does not have full row rank 2p (the message names the row).
     FRICONT_ERR_RANK_DEFICIENT = -205,
@@ -83,6 +88,11 @@ pub enum fricont_status {
     /// Callback: a load callback returned 0 but wrote a NaN or infinite value; handled as
     /// `FRICONT_ERR_CALLBACK` (callback code 0).
     FRICONT_ERR_CALLBACK_VALUE = -402,
+    /// Callback: the host's solve (`fricont_problem_new_solve`) failed: it returned a
+    /// negative code, a positive (recoverable) code twice in a row for the same block (it
+    /// is retried once), or wrote a NaN or infinite value. Its code is in the message
+    /// and, for a path, in `fricont_path_callback_code` (0 for NaN/Inf).
+    FRICONT_ERR_SOLVE_CALLBACK = -403,
     /// Internal: a panic (a bug in fricont) was caught at the C boundary. The message says
     /// where; the handle is poisoned (every later call on it returns
     /// `FRICONT_ERR_POISONED`) and should be freed.
@@ -93,7 +103,7 @@ pub enum fricont_status {
 
 impl fricont_status {
     /// Every status, for tests and `fricont_status_str`.
-    pub const ALL: [fricont_status; 20] = {
+    pub const ALL: [fricont_status; 22] = {
         use fricont_status::*;
         [
             FRICONT_OK,
@@ -105,6 +115,7 @@ impl fricont_status {
             FRICONT_ERR_LENGTH,
             FRICONT_ERR_RANGE,
             FRICONT_ERR_ORDER,
+            FRICONT_ERR_UNAVAILABLE,
             FRICONT_ERR_CSR,
             FRICONT_ERR_NONFINITE,
             FRICONT_ERR_NOT_SYMMETRIC,
@@ -114,6 +125,7 @@ impl fricont_status {
             FRICONT_ERR_NUMERICAL,
             FRICONT_ERR_CALLBACK,
             FRICONT_ERR_CALLBACK_VALUE,
+            FRICONT_ERR_SOLVE_CALLBACK,
             FRICONT_ERR_PANIC,
             FRICONT_ERR_POISONED,
         ]
@@ -134,10 +146,13 @@ impl fricont_status {
             FRICONT_ERR_LENGTH => "FRICONT_ERR_LENGTH: an array length or dimension does not fit\0",
             FRICONT_ERR_RANGE => "FRICONT_ERR_RANGE: a parameter is out of its range\0",
             FRICONT_ERR_ORDER => "FRICONT_ERR_ORDER: a call made in the wrong order\0",
+            FRICONT_ERR_UNAVAILABLE => {
+                "FRICONT_ERR_UNAVAILABLE: u is not available for a problem made from condensed data\0"
+            }
             FRICONT_ERR_CSR => "FRICONT_ERR_CSR: a malformed CSR matrix\0",
             FRICONT_ERR_NONFINITE => "FRICONT_ERR_NONFINITE: a NaN or infinite input value\0",
-            FRICONT_ERR_NOT_SYMMETRIC => "FRICONT_ERR_NOT_SYMMETRIC: A is not symmetric\0",
-            FRICONT_ERR_NOT_SPD => "FRICONT_ERR_NOT_SPD: A is not positive definite\0",
+            FRICONT_ERR_NOT_SYMMETRIC => "FRICONT_ERR_NOT_SYMMETRIC: A or W is not symmetric\0",
+            FRICONT_ERR_NOT_SPD => "FRICONT_ERR_NOT_SPD: A or W is not positive definite\0",
             FRICONT_ERR_RANK_DEFICIENT => {
                 "FRICONT_ERR_RANK_DEFICIENT: B = [N; T] does not have full row rank\0"
             }
@@ -148,6 +163,9 @@ impl fricont_status {
             }
             FRICONT_ERR_CALLBACK_VALUE => {
                 "FRICONT_ERR_CALLBACK_VALUE: a load callback wrote a NaN or infinite value\0"
+            }
+            FRICONT_ERR_SOLVE_CALLBACK => {
+                "FRICONT_ERR_SOLVE_CALLBACK: the host's solve callback failed\0"
             }
             FRICONT_ERR_PANIC => {
                 "FRICONT_ERR_PANIC: internal error (panic caught at the C boundary)\0"

@@ -581,12 +581,25 @@ impl Path {
         // (the free displacement under the load is often orders of magnitude larger than
         // u) and lose the residual's accuracy.
         let f = self.load.force(alpha)?;
-        Ok(self.state_with_force(lam, alpha, classes, f))
+        self.state_with_force(lam, alpha, classes, f)
     }
 
-    fn state_with_force(&self, lam: &[f64], alpha: f64, classes: &[Class], f: Vec<f64>) -> State {
-        let u = self.problem.delassus().displacement(&f, lam);
-        self.state_from_u(lam, alpha, classes, &f, u)
+    /// The state at a point; u is empty when the problem cannot solve with A (condensed
+    /// input). Errors: the host's solve failed.
+    fn state_with_force(
+        &self,
+        lam: &[f64],
+        alpha: f64,
+        classes: &[Class],
+        f: Vec<f64>,
+    ) -> Result<State> {
+        let del = self.problem.delassus();
+        let u = if del.has_solve() {
+            del.displacement(&f, lam)?
+        } else {
+            Vec::new()
+        };
+        Ok(self.state_from_u(lam, alpha, classes, &f, u))
     }
 
     /// The state with u already solved for.

@@ -42,7 +42,7 @@ impl Path {
         let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
         let lam = self.lam_to_internal(&lam);
         let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
-        Ok(self.state_with_force(&lam, e.alpha, &e.classes, f))
+        self.state_with_force(&lam, e.alpha, &e.classes, f)
     }
 
     /// The full states of events `range` (as [`Path::event_state`]), with the back-solves
@@ -60,6 +60,7 @@ impl Path {
             )));
         }
         let n = self.problem.n();
+        let has_solve = self.problem.delassus().has_solve();
         // One solve per transition point in the range.
         let mut firsts: Vec<usize> = Vec::new();
         for k in range.clone() {
@@ -79,14 +80,18 @@ impl Path {
                 let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
                 let lam = self.lam_to_internal(&lam);
                 let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
-                let mut rhs = f.clone();
-                self.problem.b().mul_t_vec_add(&lam, &mut rhs);
-                for (i, v) in rhs.into_iter().enumerate() {
-                    x[(i, c)] = v;
+                if has_solve {
+                    let mut rhs = f.clone();
+                    self.problem.b().mul_t_vec_add(&lam, &mut rhs);
+                    for (i, v) in rhs.into_iter().enumerate() {
+                        x[(i, c)] = v;
+                    }
                 }
                 inputs.push((k, lam, f));
             }
-            self.problem.delassus().solve_mat_in_place(x.as_mut());
+            if has_solve {
+                self.problem.delassus().solve_mat_in_place(x.as_mut())?;
+            }
             for (c, (k, lam, f)) in inputs.into_iter().enumerate() {
                 let e = &tr.events[k];
                 let u: Vec<f64> = (0..n).map(|i| x[(i, c)]).collect();

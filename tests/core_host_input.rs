@@ -1,0 +1,412 @@
+//! The two constructors for hosts that do not hand over A (issue 13), against the A, N, T
+//! constructor on the test families (random brute-force problems, finite-element meshes,
+//! symmetric bodies, folds, vertical pieces, mirror pairs):
+//!
+//! * **condensed input**: W and the condensed load `q = B A⁻¹ f` formed here with
+//!   nalgebra's dense Cholesky (not fricont's sparse one), given to
+//!   [`ProblemBuilder::condensed`];
+//! * **a host's solve**: N, T and a solve closure by nalgebra's dense Cholesky, given to
+//!   [`ProblemBuilder::with_solve`] in blocks of at most 3 columns.
+//!
+//! Both must trace the same events (α to 1e-12 relative, nodes, classes, fold and
+//! bifurcation flags) with the same λ; u at events through the solve equals the built-in
+//! u to 1e-12 relative. Bad input gives its documented error.
+
+mod common;
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use common::{
+    Brute, Case, Data, fe_case, fold_problem, mirror_pair, random_case, symmetric_case,
+    vertical_problem,
+};
+use fricont::condense::{HostSolve, SolveFailure};
+use fricont::load::Load;
+use fricont::path::{Path, PathOptions};
+use fricont::problem::{CsrMatrix, Problem, ProblemBuilder};
+use fricont::{Error, faer};
+use nalgebra::{DMatrix, DVector};
+
+fn csr(m: &DMatrix<f64>) -> CsrMatrix {
+    let rm: Vec<f64> = (0..m.nrows())
+        .flat_map(|i| (0..m.ncols()).map(move |j| (i, j)))
+        .map(|(i, j)| m[(i, j)])
+        .collect();
+    CsrMatrix::from_dense(m.nrows(), m.ncols(), &rm).unwrap()
+}
+
+fn to_faer(m: &DMatrix<f64>) -> faer::Mat<f64> {
+    faer::Mat::from_fn(m.nrows(), m.ncols(), |i, j| m[(i, j)])
+}
+
+/// W and the condensed affine load, by nalgebra.
+fn condensed_data(data: &Data) -> (DMatrix<f64>, DVector<f64>, DVector<f64>) {
+    let (b, w) = Brute::condensed(data);
+    let chol = data.a.clone().cholesky().expect("A SPD");
+    (w, &b * chol.solve(&data.f0), &b * chol.solve(&data.f1))
+}
+
+fn condensed_problem(data: &Data) -> (Problem, Load) {
+    let (w, q0, q1) = condensed_data(data);
+    let problem = ProblemBuilder::condensed(to_faer(&w))
+        .friction(data.friction.clone())
+        .gap(data.gap.clone())
+        .build()
+        .expect("condensed problem");
+    let load = Load::affine(q0.as_slice().to_vec(), q1.as_slice().to_vec()).unwrap();
+    (problem, load)
+}
+
+/// A host's solve by nalgebra's Cholesky, counting the columns it was asked to solve.
+fn nalgebra_solve(a: &DMatrix<f64>, max_block: usize, columns: Arc<AtomicUsize>) -> HostSolve {
+    let chol = a.clone().cholesky().expect("A SPD");
+    HostSolve::new(
+        Box::new(move |mut x| {
+            assert!(x.ncols() <= max_block, "block of {} columns", x.ncols());
+            columns.fetch_add(x.ncols(), Ordering::Relaxed);
+            for c in 0..x.ncols() {
+                let b = DVector::from_fn(x.nrows(), |i, _| x[(i, c)]);
+                let y = chol.solve(&b);
+                for i in 0..x.nrows() {
+                    x[(i, c)] = y[i];
+                }
+            }
+            Ok(())
+        }),
+        max_block,
+    )
+}
+
+fn solve_problem(data: &Data) -> Problem {
+    let nm = csr(&data.nm);
+    let tm = csr(&data.tm);
+    let solve = nalgebra_solve(&data.a, 3, Arc::new(AtomicUsize::new(0)));
+    ProblemBuilder::with_solve(data.n, solve, nm, tm)
+        .friction(data.friction.clone())
+        .gap(data.gap.clone())
+        .build()
+        .expect("problem with a host's solve")
+}
+
+fn run(problem: Problem, load: Load, a0: f64, a1: f64) -> Path {
+    let mut path = Path::new(Arc::new(problem), load, PathOptions::window(a0, a1)).unwrap();
+    path.start(a0, None).expect("start");
+    path.run().expect("run");
+    path
+}
+
+fn inf(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
+}
+
+/// Same events and λ; returns the number of events.
+fn assert_same_path(ctx: &str, reference: &Path, other: &Path) -> usize {
+    let (er, eo) = (reference.events(), other.events());
+    assert_eq!(er.len(), eo.len(), "{ctx}: number of events");
+    // λ compared on the path's force scale (at a point where all forces vanish, the
+    // event's own forces are rounding noise).
+    let scale = reference.pieces().iter().fold(1e-300f64, |m, pc| {
+        m.max(inf(&pc.lambda_from)).max(inf(&pc.lambda_to))
+    });
+    for (x, y) in er.iter().zip(eo) {
+        let tol = 1e-12 * 1f64.max(x.alpha.abs());
+        assert!(
+            (x.alpha - y.alpha).abs() <= tol,
+            "{ctx}: event {} at α {:.17e} (A, N, T) vs {:.17e}",
+            x.index + 1,
+            x.alpha,
+            y.alpha
+        );
+        assert_eq!(
+            (x.node, x.from, x.to, x.fold, x.bifurcation, x.transition),
+            (y.node, y.from, y.to, y.fold, y.bifurcation, y.transition),
+            "{ctx}: event {}",
+            x.index + 1
+        );
+        for (a, b) in x
+            .lambda_n
+            .iter()
+            .chain(&x.lambda_t)
+            .zip(y.lambda_n.iter().chain(&y.lambda_t))
+        {
+            assert!(
+                (a - b).abs() <= 1e-10 * scale,
+                "{ctx}: event {}: λ {a:e} vs {b:e} (scale {scale:e})",
+                x.index + 1
+            );
+        }
+    }
+    assert_eq!(
+        reference.end_reason(),
+        other.end_reason(),
+        "{ctx}: end reason"
+    );
+    er.len()
+}
+
+fn check_case(ctx: &str, data: &Data, a0: f64, a1: f64) -> usize {
+    let reference = run(data.problem(), data.affine_load(), a0, a1);
+    // Condensed input: same events and λ; states have no u, and a small residual.
+    let (cp, cl) = condensed_problem(data);
+    assert!(!cp.has_displacement() && cp.is_condensed() && cp.n() == 0);
+    let condensed = run(cp, cl, a0, a1);
+    let n = assert_same_path(&format!("{ctx} (condensed)"), &reference, &condensed);
+    // A host's solve: same events and λ, and u at events equal to fricont's own u.
+    let hosted = run(solve_problem(data), data.affine_load(), a0, a1);
+    assert_same_path(&format!("{ctx} (host's solve)"), &reference, &hosted);
+    if n > 0 {
+        let all = 0..n;
+        let (sr, sc, sh) = (
+            reference.event_states(all.clone()).unwrap(),
+            condensed.event_states(all.clone()).unwrap(),
+            hosted.event_states(all).unwrap(),
+        );
+        // u against the magnitude of its terms, A⁻¹f and A⁻¹Bᵀλ (where they cancel, u is
+        // rounding noise of that size).
+        let chol = data.a.clone().cholesky().expect("A SPD");
+        let free = |alpha: f64| inf(chol.solve(&data.force(alpha)).as_slice());
+        for k in 0..n {
+            let scale = inf(&sr[k].u).max(free(sr[k].alpha)).max(1e-300);
+            assert!(sc[k].u.is_empty(), "{ctx}: condensed state has a u");
+            assert!(
+                sc[k].residual <= 1e-12,
+                "{ctx}: event {}: condensed residual {:e}",
+                k + 1,
+                sc[k].residual
+            );
+            assert!(
+                sh[k].residual <= 1e-12,
+                "{ctx}: event {}: host-solve residual {:e}",
+                k + 1,
+                sh[k].residual
+            );
+            let d = sr[k]
+                .u
+                .iter()
+                .zip(&sh[k].u)
+                .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
+            assert!(
+                d <= 1e-12 * scale,
+                "{ctx}: event {}: u differs by {:e} relative",
+                k + 1,
+                d / scale
+            );
+        }
+    }
+    n
+}
+
+fn check(ctx: &str, case: &Case) -> usize {
+    check_case(ctx, &case.data, case.a0, case.a1)
+}
+
+#[test]
+fn random_problems() {
+    let mut events = 0;
+    for seed in 0..120 {
+        events += check(&format!("random seed {seed}"), &random_case(seed));
+    }
+    assert!(events > 250, "only {events} events compared");
+}
+
+#[test]
+fn finite_element_meshes() {
+    let mut events = 0;
+    for seed in 0..24u64 {
+        let nx = 3 + (seed % 4) as usize;
+        let ny = 1 + ((seed / 4) % 3) as usize;
+        let friction = [0.3, 1.0, 3.0, 5.0][((seed / 6) % 4) as usize];
+        events += check(
+            &format!("FE seed {seed} ({nx}x{ny}, F = {friction})"),
+            &fe_case(seed, nx, ny, friction),
+        );
+    }
+    assert!(events > 60, "only {events} events compared");
+}
+
+#[test]
+fn symmetric_bodies_folds_and_vertical_pieces() {
+    for seed in 0..16 {
+        check(
+            &format!("symmetric seed {seed}"),
+            &symmetric_case(seed, seed % 2 == 1),
+        );
+    }
+    let mut folds = 0;
+    for (name, data, a0, a1) in [
+        ("fold problem", fold_problem(), -3.0, 3.0),
+        ("vertical problem", vertical_problem(), -2.0, 2.0),
+        ("mirror pair", mirror_pair(), -2.0, 2.0),
+    ] {
+        check_case(name, &data, a0, a1);
+        folds += run(data.problem(), data.affine_load(), a0, a1)
+            .events()
+            .iter()
+            .filter(|e| e.fold)
+            .count();
+    }
+    assert!(folds > 0, "the fold family has no fold");
+}
+
+/// W by the host's solve equals W by fricont's own factor; the solve is called in blocks
+/// of at most `max_block` columns, 2p columns in all for W.
+#[test]
+fn host_solve_forms_w_in_blocks() {
+    let case = fe_case(3, 5, 2, 1.0);
+    let data = &case.data;
+    let cols = Arc::new(AtomicUsize::new(0));
+    let hosted = ProblemBuilder::with_solve(
+        data.n,
+        nalgebra_solve(&data.a, 4, cols.clone()),
+        csr(&data.nm),
+        csr(&data.tm),
+    )
+    .build()
+    .unwrap();
+    assert_eq!(cols.load(Ordering::Relaxed), 2 * data.p);
+    let own = data.problem();
+    let (wh, wo) = (hosted.delassus().w(), own.delassus().w());
+    let big = (0..wo.nrows()).fold(0.0f64, |m, i| m.max(wo[(i, i)]));
+    for i in 0..wo.nrows() {
+        for j in 0..wo.ncols() {
+            assert!(
+                (wh[(i, j)] - wo[(i, j)]).abs() <= 1e-13 * big,
+                "W({i}, {j})"
+            );
+        }
+    }
+    assert!(hosted.a().is_none() && hosted.has_displacement());
+}
+
+#[test]
+fn bad_condensed_input_is_rejected() {
+    let data = fe_case(1, 4, 1, 1.0).data;
+    let (w, _, _) = condensed_data(&data);
+    let m = w.nrows();
+    let build = |w: DMatrix<f64>| ProblemBuilder::condensed(to_faer(&w)).build();
+    // Not symmetric.
+    let mut ns = w.clone();
+    ns[(0, 1)] += 1e-6 * w[(0, 0)];
+    assert!(matches!(build(ns), Err(Error::NotSymmetric(_))));
+    // Indefinite: a row that is a combination of others (rank-deficient), and a negative
+    // diagonal; the message names the row.
+    let mut dep = w.clone();
+    dep.row_mut(m - 1).copy_from(&w.row(0));
+    dep.column_mut(m - 1).copy_from(&w.column(0));
+    dep[(m - 1, m - 1)] = w[(0, 0)];
+    match build(dep) {
+        Err(Error::WNotSpd(msg)) => assert!(msg.contains(&format!("row {m}")), "{msg}"),
+        other => panic!("dependent row: {other:?}"),
+    }
+    let mut neg = w.clone();
+    neg[(2, 2)] = -1.0;
+    match build(neg) {
+        Err(Error::WNotSpd(msg)) => assert!(msg.contains("row 3"), "{msg}"),
+        other => panic!("negative diagonal: {other:?}"),
+    }
+    // NaN, odd size, empty.
+    let mut nan = w.clone();
+    nan[(1, 0)] = f64::NAN;
+    assert!(matches!(build(nan), Err(Error::NonFinite(_))));
+    assert!(matches!(
+        build(w.view((0, 0), (m - 1, m - 1)).into_owned()),
+        Err(Error::Dimension(_))
+    ));
+    assert!(matches!(
+        build(DMatrix::zeros(0, 0)),
+        Err(Error::InvalidParameter(_))
+    ));
+    // A load of n entries given to a condensed problem.
+    let (cp, _) = condensed_problem(&data);
+    let e = Path::new(
+        Arc::new(cp),
+        data.affine_load(),
+        PathOptions::window(0.0, 1.0),
+    )
+    .err()
+    .expect("an n-entry load for a condensed problem");
+    assert!(
+        matches!(e, Error::Dimension(ref m) if m.contains("2p")),
+        "{e:?}"
+    );
+}
+
+#[test]
+fn failing_or_wrong_host_solves_are_errors() {
+    let data = random_case(8).data;
+    let with = |f: fricont::condense::SolveFn| {
+        ProblemBuilder::with_solve(data.n, HostSolve::new(f, 8), csr(&data.nm), csr(&data.tm))
+            .build()
+    };
+    // Fatal code: an error with the host's code.
+    let e = with(Box::new(|_| {
+        Err(SolveFailure {
+            code: -7,
+            message: "out of licences".into(),
+        })
+    }))
+    .unwrap_err();
+    assert!(matches!(e, Error::HostSolve { code: -7, .. }), "{e:?}");
+    // Recoverable once: retried on the restored right-hand sides, and then succeeds
+    // (the first call scribbles over x before failing).
+    let chol = data.a.clone().cholesky().unwrap();
+    let mut calls = 0;
+    let flaky = with(Box::new(move |mut x| {
+        calls += 1;
+        if calls == 1 {
+            x.fill(123.0);
+            return Err(SolveFailure {
+                code: 2,
+                message: "busy".into(),
+            });
+        }
+        for c in 0..x.ncols() {
+            let y = chol.solve(&DVector::from_fn(x.nrows(), |i, _| x[(i, c)]));
+            for i in 0..x.nrows() {
+                x[(i, c)] = y[i];
+            }
+        }
+        Ok(())
+    }))
+    .expect("a recoverable failure is retried");
+    let own = data.problem();
+    let (wf, wo) = (flaky.delassus().w(), own.delassus().w());
+    assert!((wf[(0, 0)] - wo[(0, 0)]).abs() <= 1e-13 * wo[(0, 0)]);
+    // Recoverable twice in a row: an error.
+    let e = with(Box::new(|_| {
+        Err(SolveFailure {
+            code: 3,
+            message: "busy".into(),
+        })
+    }))
+    .unwrap_err();
+    assert!(matches!(e, Error::HostSolve { code: 3, .. }), "{e:?}");
+    // NaN in the result.
+    let e = with(Box::new(|mut x| {
+        x[(0, 0)] = f64::NAN;
+        Ok(())
+    }))
+    .unwrap_err();
+    assert!(matches!(e, Error::HostSolve { code: 0, .. }), "{e:?}");
+    // A solve that is not that of a symmetric matrix (A + a skew part).
+    let mut skew = data.a.clone();
+    skew[(0, 1)] += 0.3 * data.a[(0, 0)];
+    let lu = skew.lu();
+    let e = with(Box::new(move |mut x| {
+        for c in 0..x.ncols() {
+            let y = lu
+                .solve(&DVector::from_fn(x.nrows(), |i, _| x[(i, c)]))
+                .unwrap();
+            for i in 0..x.nrows() {
+                x[(i, c)] = y[i];
+            }
+        }
+        Ok(())
+    }))
+    .unwrap_err();
+    assert!(
+        matches!(e, Error::NotSymmetric(ref m) if m.contains("host")),
+        "{e:?}"
+    );
+}
