@@ -15,8 +15,14 @@
  * in alpha, guards that hold at both ends of every piece hold along the whole path: no
  * transition was skipped.
  *
+ * With --via condensed, fricont gets only the W and q formed here by CHOLMOD
+ * (fricont_problem_new_condensed): states have no u, and the u and H checks are skipped
+ * (lambda is still checked against the piece equations solved here). With --via solve,
+ * fricont gets N, T and a solve callback that applies A^-1 with CHOLMOD's factor
+ * (fricont_problem_new_solve, blocks of at most 16 columns): every check applies.
+ *
  * usage: cholmod_ref DIR [--base 0|1] [--storage full|lower|upper] [--F value] [--r value]
- *                        [--events FILE]
+ *                        [--events FILE] [--via ann|condensed|solve]
  */
 #include <math.h>
 #include <stdlib.h>
@@ -58,6 +64,23 @@ static void chol_solve(ref_t *R, double *x) {
     memcpy(x, sol->x, sizeof(double) * (size_t)R->n);
     cholmod_free_dense(&sol, &R->cm);
     cholmod_free_dense(&rhs, &R->cm);
+}
+
+/* The host's solve given to fricont_problem_new_solve: a block of columns by CHOLMOD. */
+static int chol_block(void *user, int64_t n, int64_t ncols, double *x, int64_t ldx) {
+    ref_t *R = user;
+    if (n != R->n || ncols < 1 || ncols > 16 || ldx < n) return -1;
+    cholmod_dense *rhs = cholmod_allocate_dense((size_t)n, (size_t)ncols, (size_t)n, CHOLMOD_REAL, &R->cm);
+    if (!rhs) return -2;
+    double *rx = rhs->x;
+    for (int64_t j = 0; j < ncols; j++) memcpy(rx + j * n, x + j * ldx, sizeof(double) * (size_t)n);
+    cholmod_dense *sol = cholmod_solve(CHOLMOD_A, R->L, rhs, &R->cm);
+    cholmod_free_dense(&rhs, &R->cm);
+    if (!sol) return -3;
+    double *sx = sol->x;
+    for (int64_t j = 0; j < ncols; j++) memcpy(x + j * ldx, sx + j * n, sizeof(double) * (size_t)n);
+    cholmod_free_dense(&sol, &R->cm);
+    return 0;
 }
 
 static void csr_mul(const csr *m, const double *x, double *y) {
@@ -351,6 +374,12 @@ static void check_point(ref_t *R, const char *what, double alpha, const int32_t 
         }
         free(lb);
     }
+    CHECK(lib_residual <= H_TOL, "%s: the library reports residual %g", what, lib_residual);
+    if (!u) { /* condensed input: no displacement */
+        free(lam);
+        free(lref);
+        return;
+    }
     /* u = A^-1 (f + B^T lambda) by CHOLMOD from the reference lambda */
     const double *lu = singular ? lam : lref;
     double *uref = malloc(sizeof(double) * (size_t)n);
@@ -364,9 +393,6 @@ static void check_point(ref_t *R, const char *what, double alpha, const int32_t 
     CHECK(e <= REL_TOL * us, "%s (alpha %.15g): u differs from CHOLMOD's by %g relative", what, alpha, e / us);
     double h = h_residual(R, alpha, u, lam);
     CHECK(h <= H_TOL, "%s (alpha %.15g): ||H|| = %g relative > %g", what, alpha, h, H_TOL);
-    /* The library's own residual (its scale: the largest force-like term) must meet the
-     * same bound. */
-    CHECK(lib_residual <= H_TOL, "%s: the library reports residual %g", what, lib_residual);
     free(uref);
     free(lam);
     free(lref);
@@ -377,7 +403,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "usage: %s DIR [--base 0|1] [--storage full|lower|upper] [--F value] [--r value] [--events FILE]\n", argv[0]);
         return 2;
     }
-    const char *dir = argv[1], *events_file = NULL;
+    const char *dir = argv[1], *events_file = NULL, *via = "ann";
     int64_t base = 0;
     int32_t storage = FRICONT_STORAGE_FULL;
     double F = -1, r = -1;
@@ -390,6 +416,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[i], "--F")) F = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--r")) r = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--events")) events_file = argv[i + 1];
+        else if (!strcmp(argv[i], "--via")) via = argv[i + 1];
     }
     ref_t R;
     memset(&R, 0, sizeof R);
@@ -402,15 +429,33 @@ int main(int argc, char **argv) {
     if (setup(&R)) return 2;
     int64_t n = R.n, p = R.p;
 
+    int condensed = !strcmp(via, "condensed"), hosted = !strcmp(via, "solve");
     fricont_problem *prob = NULL;
-    fricont_status st = problem_from_case(&R.c, storage, base, &prob);
-    CHECK(st == FRICONT_OK, "problem: %s", fricont_status_str(st));
+    fricont_status st;
+    if (condensed) {
+        /* W here is row-major; fricont reads column-major, i.e. W^T (it symmetrises) */
+        st = fricont_problem_new_condensed(p, R.w, R.m, &prob);
+        if (st == FRICONT_OK) st = set_case_settings(&R.c, prob);
+    } else if (hosted) {
+        csr nm = csr_from_triplets(&R.c.nm, PART_FULL, base), tm = csr_from_triplets(&R.c.tm, PART_FULL, base);
+        fricont_csr nv = csr_view(&nm), tv = csr_view(&tm);
+        st = fricont_problem_new_solve(n, chol_block, &R, 16, &nv, &tv, &prob);
+        free_csr(&nm);
+        free_csr(&tm);
+        if (st == FRICONT_OK) st = set_case_settings(&R.c, prob);
+    } else {
+        st = problem_from_case(&R.c, storage, base, &prob);
+    }
+    CHECK(st == FRICONT_OK, "problem (via %s): %s", via, fricont_status_str(st));
     if (r > 0) CHECK(fricont_problem_set_r(prob, r) == FRICONT_OK, "set_r");
     double r0 = 0;
     CHECK(fricont_problem_r(prob, &R.r, &r0) == FRICONT_OK, "problem_r");
-    CHECK(fabs(r0 - R.rs) <= 1e-10 * R.rs, "default r %.17g differs from 2p/trace(W) = %.17g", r0, R.rs);
+    /* (condensed input equilibrates W by its own diagonal, so its default r differs) */
+    if (!condensed)
+        CHECK(fabs(r0 - R.rs) <= 1e-10 * R.rs, "default r %.17g differs from 2p/trace(W) = %.17g", r0, R.rs);
     fricont_path *path = NULL;
-    st = fricont_path_new_affine(prob, R.c.f0, R.c.f1, n, &path);
+    st = condensed ? fricont_path_new_affine(prob, R.q0, R.q1, R.m, &path)
+                   : fricont_path_new_affine(prob, R.c.f0, R.c.f1, n, &path);
     CHECK(st == FRICONT_OK, "path: %s", fricont_status_str(st));
     fricont_problem_free(prob);
     CHECK(fricont_path_set_window(path, R.c.alpha_start, R.c.alpha_end) == FRICONT_OK, "window");
@@ -427,9 +472,9 @@ int main(int argc, char **argv) {
     double *u = malloc(sizeof(double) * (size_t)n), *ln = malloc(sizeof(double) * (size_t)p),
            *lt = malloc(sizeof(double) * (size_t)p);
     int32_t *cls = malloc(sizeof(int32_t) * (size_t)p), *prev = malloc(sizeof(int32_t) * (size_t)p);
-    fricont_state s = {0, 0, u, n, ln, p, lt, p, cls, p};
+    fricont_state s = {0, 0, condensed ? NULL : u, condensed ? 0 : n, ln, p, lt, p, cls, p};
     CHECK(fricont_path_start_state(path, &s) == FRICONT_OK, "start_state");
-    check_point(&R, "start", s.alpha, cls, NULL, u, ln, lt, s.residual);
+    check_point(&R, "start", s.alpha, cls, NULL, s.u, ln, lt, s.residual);
 
     st = fricont_path_run(path);
     CHECK(st == FRICONT_END, "run: %s", fricont_status_str(st));
@@ -468,7 +513,7 @@ int main(int argc, char **argv) {
         t_prev = ev.transition;
         char what[64];
         snprintf(what, sizeof what, "event %lld", (long long)k + 1);
-        check_point(&R, what, ev.alpha, cls, prev, u, ln, lt, ev.residual);
+        check_point(&R, what, ev.alpha, cls, prev, s.u, ln, lt, ev.residual);
     }
     if (ef) fclose(ef);
     /* pieces: guards at both ends and the middle with the reference solution */
@@ -506,10 +551,10 @@ int main(int argc, char **argv) {
             CHECK(s.alpha == a, "solution alpha");
             char what[64];
             snprintf(what, sizeof what, "solution at sample %d", j + 1);
-            check_point(&R, what, a, cls, NULL, u, ln, lt, s.residual);
+            check_point(&R, what, a, cls, NULL, s.u, ln, lt, s.residual);
         }
     }
-    printf("%s: %lld events, %lld pieces, r = %.6g (default %.6g)\n", dir, (long long)ne, (long long)np, R.r, r0);
+    printf("%s (via %s): %lld events, %lld pieces, r = %.6g (default %.6g)\n", dir, via, (long long)ne, (long long)np, R.r, r0);
     free(u);
     free(ln);
     free(lt);

@@ -225,7 +225,11 @@ fricont_status problem_from_case(const case_data *c, int32_t storage, int64_t ba
     free_csr(&nm);
     free_csr(&tm);
     if (st != FRICONT_OK) return st;
-    st = fricont_problem_set_friction_nodes(*out, c->friction, c->p);
-    if (st == FRICONT_OK && c->gap) st = fricont_problem_set_gap(*out, c->gap, c->p);
+    return set_case_settings(c, *out);
+}
+
+fricont_status set_case_settings(const case_data *c, fricont_problem *p) {
+    fricont_status st = fricont_problem_set_friction_nodes(p, c->friction, c->p);
+    if (st == FRICONT_OK && c->gap) st = fricont_problem_set_gap(p, c->gap, c->p);
     return st;
 }

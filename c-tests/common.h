@@ -46,6 +46,8 @@ fricont_csr csr_view(const csr *m);
  * from the case. Returns the status of the first failing call. */
 fricont_status problem_from_case(const case_data *c, int32_t storage, int64_t base,
                                  fricont_problem **out);
+/* Sets a case's friction and gap on a problem handle (any constructor). */
+fricont_status set_case_settings(const case_data *c, fricont_problem *p);
 
 /* Pass/fail bookkeeping. */
 extern long g_passed, g_failed;

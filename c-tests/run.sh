@@ -84,6 +84,21 @@ if [ -f "$SAMPLE/meta.json" ]; then
     run "CHOLMOD reference: sample, upper, r = 10" "$OUT/cholmod_ref" "$SAMPLE" --storage upper --r 10
     run "CHOLMOD reference: sample, F = 0.9" "$OUT/cholmod_ref" "$SAMPLE" --F 0.9
     run "CHOLMOD reference: sample, F = 0" "$OUT/cholmod_ref" "$SAMPLE" --F 0
+    # The hosts' constructors: condensed W and q by CHOLMOD, and CHOLMOD as the host's solve.
+    for via in condensed solve; do
+        run "CHOLMOD reference: sample, via $via" "$OUT/cholmod_ref" "$SAMPLE" --via "$via" --events "$OUT/sample-events-$via.txt"
+        if python3 - "$OUT/sample-events.txt" "$OUT/sample-events-$via.txt" <<'PY'
+import sys
+a = [l.split() for l in open(sys.argv[1]) if l.strip()]
+b = [l.split() for l in open(sys.argv[2]) if l.strip()]
+assert len(a) == len(b) and a, f"{len(a)} events from A, N, T; {len(b)} via the host's constructor"
+for x, y in zip(a, b):
+    # alpha to 1e-10 relative: the sample's event 3 is determined by the data to ~2e-11
+    assert abs(float(x[0]) - float(y[0])) <= 1e-10 * max(1.0, abs(float(x[0]))), (x, y)
+    assert x[1:] == y[1:], (x, y)
+PY
+        then pass "via $via: the events of the A, N, T constructor on the sample"; else fail "via $via: events differ from the A, N, T constructor's"; fi
+    done
     run "loads and threads: sample" "$OUT/paths" "$SAMPLE"
     # the same events as the CLI (when the CLI can trace)
     CLI="$LIBDIR/fricont"
@@ -106,6 +121,8 @@ else
     fail "sample case not found at $SAMPLE (set FRICONT_CASES)"
 fi
 run "loads and threads: Q1 example" "$OUT/paths" "$Q1"
+run "CHOLMOD reference: Q1 example, via condensed" "$OUT/cholmod_ref" "$Q1" --F 1.2 --via condensed
+run "CHOLMOD reference: Q1 example, via solve, 1-based" "$OUT/cholmod_ref" "$Q1" --F 1.2 --via solve --base 1
 
 # --- valgrind ------------------------------------------------------------------------------
 if command -v valgrind >/dev/null; then
@@ -119,6 +136,8 @@ if command -v valgrind >/dev/null; then
     fi
     run "valgrind status codes" "${VG[@]}" "$OUT/status"
     run "valgrind CHOLMOD reference: Q1 example" "${VG[@]}" "$OUT/cholmod_ref" "$Q1"
+    run "valgrind CHOLMOD reference: Q1 example, via solve" "${VG[@]}" "$OUT/cholmod_ref" "$Q1" --via solve
+    run "valgrind CHOLMOD reference: Q1 example, via condensed" "${VG[@]}" "$OUT/cholmod_ref" "$Q1" --via condensed
     run "valgrind loads and threads: Q1 example" "${VG[@]}" "$OUT/paths" "$Q1"
     if [ -f "$SAMPLE/meta.json" ]; then
         run "valgrind CHOLMOD reference: sample" "${VG[@]}" "$OUT/cholmod_ref" "$SAMPLE"

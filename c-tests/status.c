@@ -704,6 +704,126 @@ static void test_bifurcation(void) {
     }
 }
 
+/* ---- condensed input and a host's solve, on the block above ----
+ * W = B A^-1 B^T = diag(1/2, 1), q(alpha) = B A^-1 f(alpha) = (1/2, alpha): the same path,
+ * stick with lambda = (-1, -alpha) up to alpha = 1/2, then slip+ with u_2 = alpha - 1/2. */
+typedef struct {
+    int calls, fail_from, fail_code, fail_times;
+} solve_data;
+
+/* A^-1 = diag(1/2, 1); fails with fail_code on calls fail_from .. fail_from + fail_times - 1
+ * (after scribbling over x, which fricont must restore before a retry). */
+static int diag_solve(void *user, int64_t n, int64_t ncols, double *x, int64_t ldx) {
+    solve_data *d = user;
+    d->calls++;
+    if (n != 2 || ldx < n || ncols < 1) return -99;
+    if (d->fail_from > 0 && d->calls >= d->fail_from && d->calls < d->fail_from + d->fail_times) {
+        x[0] = 1e300;
+        return d->fail_code;
+    }
+    for (int64_t j = 0; j < ncols; j++) x[j * ldx] *= 0.5;
+    return 0;
+}
+
+static void test_host_input(void) {
+    double w[4] = {0.5, 0.0, 0.0, 1.0}, q0[2] = {0.5, 0.0}, q1[2] = {0.0, 1.0}, q3[3] = {0, 0, 0};
+    fricont_problem *p = NULL;
+    fricont_path *path = NULL;
+    /* constructor errors */
+    EXPECT(fricont_problem_new_condensed(1, NULL, 2, &p), FRICONT_ERR_NULL, "w");
+    EXPECT(fricont_problem_new_condensed(0, w, 2, &p), FRICONT_ERR_LENGTH, "p = 0");
+    EXPECT(fricont_problem_new_condensed(1, w, 1, &p), FRICONT_ERR_LENGTH, "ldw");
+    EXPECT(fricont_problem_new_condensed(-1, w, 2, &p), FRICONT_ERR_LENGTH, "p = -1");
+    EXPECT(fricont_problem_new_condensed(1, w, 2, NULL), FRICONT_ERR_NULL, "out");
+    /* bad W, found at the build */
+    double bad[3][4] = {{0.5, 0.1, 0.0, 1.0}, {0.5, 1.0, 1.0, 1.0}, {0.5, 0.0, 0.0, NAN}};
+    fricont_status want[3] = {FRICONT_ERR_NOT_SYMMETRIC, FRICONT_ERR_NOT_SPD, FRICONT_ERR_NONFINITE};
+    const char *needle[3] = {"W is not symmetric", "row 2", "W(2, 2)"};
+    for (int k = 0; k < 3; k++) {
+        EXPECT(fricont_problem_new_condensed(1, bad[k], 2, &p), FRICONT_OK, "");
+        EXPECT(fricont_problem_build(p), want[k], needle[k]);
+        fricont_problem_free(p);
+    }
+    /* the hand-derived path from condensed data */
+    EXPECT(fricont_problem_new_condensed(1, w, 2, &p), FRICONT_OK, "");
+    EXPECT(fricont_problem_set_friction(p, 0.5), FRICONT_OK, "");
+    int64_t n = -1, np = -1;
+    EXPECT(fricont_problem_dims(p, &n, &np), FRICONT_OK, "");
+    CHECK(n == 0 && np == 1, "condensed dims n = %lld, p = %lld", (long long)n, (long long)np);
+    EXPECT(fricont_path_new_affine(p, q3, q3, 3, &path), FRICONT_ERR_LENGTH, "2p = 2");
+    EXPECT(fricont_path_new_affine(p, q0, q1, 2, &path), FRICONT_OK, "");
+    EXPECT(fricont_path_set_window(path, 0.0, 1.0), FRICONT_OK, "");
+    EXPECT(fricont_path_start(path, 0.0, NULL, 0), FRICONT_OK, "");
+    EXPECT(fricont_path_run(path), FRICONT_END, "");
+    int64_t ne = 0;
+    EXPECT(fricont_path_event_count(path, &ne), FRICONT_OK, "");
+    fricont_event ev;
+    EXPECT(fricont_path_event(path, 0, &ev), FRICONT_OK, "");
+    CHECK(ne == 1 && fabs(ev.alpha - 0.5) <= 1e-15 && ev.from == FRICONT_STICK && ev.to == FRICONT_SLIP_PLUS,
+          "condensed: %lld events, first at %.17g", (long long)ne, ev.alpha);
+    double u[2], ln[1], lt[1];
+    int32_t cl[1];
+    fricont_state s = {0, 0, u, 2, ln, 1, lt, 1, cl, 1};
+    EXPECT(fricont_path_event_state(path, 0, &s), FRICONT_ERR_UNAVAILABLE, "u = NULL");
+    s.u = NULL;
+    s.u_len = 0;
+    EXPECT(fricont_path_event_state(path, 0, &s), FRICONT_OK, "");
+    CHECK(fabs(ln[0] + 1) <= 1e-15 && fabs(lt[0] + 0.5) <= 1e-15 && s.residual <= 1e-15,
+          "condensed event: lambda (%g, %g), residual %g", ln[0], lt[0], s.residual);
+    fricont_path_free(path);
+    fricont_problem_free(p);
+
+    /* a host's solve */
+    fricont_csr nm = mk(1, 2, 1, n_rp, n_ci, n_v, 0), tm = mk(1, 2, 1, t_rp, t_ci, t_v, 0);
+    solve_data sd = {0, 0, 0, 0};
+    EXPECT(fricont_problem_new_solve(2, NULL, &sd, 1, &nm, &tm, &p), FRICONT_ERR_NULL, "solve");
+    EXPECT(fricont_problem_new_solve(1, diag_solve, &sd, 1, &nm, &tm, &p), FRICONT_ERR_LENGTH, "N is 1x2");
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, 0, &nm, &tm, &p), FRICONT_ERR_LENGTH, "max_block");
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, 1, NULL, &tm, &p), FRICONT_ERR_NULL, "N");
+    /* fatal, recoverable twice, recoverable once (then fine) */
+    int codes[3] = {-3, 5, 5}, times[3] = {1, 2, 1};
+    fricont_status wants[3] = {FRICONT_ERR_SOLVE_CALLBACK, FRICONT_ERR_SOLVE_CALLBACK, FRICONT_OK};
+    const char *needles[3] = {"code -3", "code 5", ""};
+    for (int k = 0; k < 3; k++) {
+        solve_data f = {0, 1, codes[k], times[k]};
+        EXPECT(fricont_problem_new_solve(2, diag_solve, &f, 1, &nm, &tm, &p), FRICONT_OK, "");
+        EXPECT(fricont_problem_build(p), wants[k], needles[k]);
+        if (wants[k] == FRICONT_OK) {
+            double r = 0, r0 = 0;
+            EXPECT(fricont_problem_r(p, &r, &r0), FRICONT_OK, "");
+            /* W = diag(1/2, 1) after the retry: r0 = 2p / trace W = 2 / 1.5 */
+            CHECK(fabs(r0 - 2.0 / 1.5) <= 1e-15, "retried solve: r0 = %.17g", r0);
+        }
+        fricont_problem_free(p);
+    }
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, 1, &nm, &tm, &p), FRICONT_OK, "");
+    EXPECT(fricont_problem_set_friction(p, 0.5), FRICONT_OK, "");
+    EXPECT(fricont_path_new_affine(p, f0, f1, 2, &path), FRICONT_OK, "");
+    CHECK(sd.calls == 2, "W by 2 one-column solves, got %d calls", sd.calls);
+    EXPECT(fricont_path_set_window(path, 0.0, 1.0), FRICONT_OK, "");
+    EXPECT(fricont_path_start(path, 0.0, NULL, 0), FRICONT_OK, "");
+    EXPECT(fricont_path_run(path), FRICONT_END, "");
+    EXPECT(fricont_path_event(path, 0, &ev), FRICONT_OK, "");
+    CHECK(fabs(ev.alpha - 0.5) <= 1e-15, "host solve: event at %.17g", ev.alpha);
+    int64_t count = 0;
+    EXPECT(fricont_path_solutions_at(path, 0.75, &count), FRICONT_OK, "");
+    s.u = u;
+    s.u_len = 2;
+    EXPECT(fricont_path_solution(path, 0, NULL, &s), FRICONT_OK, "");
+    CHECK(count == 1 && fabs(u[0]) <= 1e-15 && fabs(u[1] - 0.25) <= 1e-15 && cl[0] == FRICONT_SLIP_PLUS,
+          "host solve at alpha 0.75: u = (%g, %g), class %d", u[0], u[1], cl[0]);
+    /* the solve fails later, for u at an event */
+    sd.fail_from = sd.calls + 1;
+    sd.fail_code = -4;
+    sd.fail_times = 1000;
+    EXPECT(fricont_path_event_state(path, 0, &s), FRICONT_ERR_SOLVE_CALLBACK, "code -4");
+    int32_t code = 0;
+    EXPECT(fricont_path_callback_code(path, &code), FRICONT_OK, "");
+    CHECK(code == -4, "callback code %d after a failing solve", code);
+    fricont_path_free(path);
+    fricont_problem_free(p);
+}
+
 /* The library must not start threads in the host program (factorisations and solves run
  * on the calling thread): after everything above, this process still has one thread. */
 static void test_no_threads_started(void) {
@@ -728,6 +848,7 @@ int main(void) {
     test_callback_failures();
     test_fold();
     test_bifurcation();
+    test_host_input();
     test_no_threads_started();
     return finish("status");
 }

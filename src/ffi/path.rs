@@ -323,10 +323,17 @@ unsafe fn new_path(
     let load_len = shared.load_len();
     let load = make_load(load_len)?;
     if load.n() != load_len {
-        return Err(Failure::length(format!(
-            "the load has {} entries, the problem takes {load_len}",
-            load.n()
-        )));
+        return Err(Failure::length(if shared.is_condensed() {
+            format!(
+                "the load has {} entries; a problem made from condensed data takes condensed loads of 2p = {load_len} entries",
+                load.n()
+            )
+        } else {
+            format!(
+                "the load has {} entries, the problem has n = {n} dofs",
+                load.n()
+            )
+        }));
     }
     let handle = Box::new(fricont_path {
         slot: ErrorSlot::default(),
