@@ -1,13 +1,15 @@
 #!/usr/bin/env bash
 # Runs every test of fricont: formatting and lints, the Rust tests (unit, integration,
-# header freshness), the C tests against the CHOLMOD reference, and the bindings.
+# header freshness), the C tests against the CHOLMOD reference, the distributed example
+# (PETSc + MUMPS over 2 MPI ranks), and the bindings.
 # Installs what it needs (Debian packages) when missing. Exits non-zero on any failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 need_pkgs=()
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
-for p in libsuitesparse-dev valgrind pkg-config cmake patchelf gfortran octave liboctave-dev; do
+for p in libsuitesparse-dev valgrind pkg-config cmake patchelf gfortran octave liboctave-dev \
+  libpetsc-real-dev openmpi-bin libopenmpi-dev; do
   have_pkg "$p" || need_pkgs+=("$p")
 done
 # Debian's python3 needs python3-venv for `python3 -m venv` (a pyenv or python.org build has it).
@@ -28,7 +30,8 @@ cargo test --release
 echo "== cargo build --release (library, CLI)"
 cargo build --release -q
 
-for suite in c-tests/run.sh cpp-tests/run.sh fortran/run.sh matlab/run.sh tests-install/run.sh; do
+for suite in c-tests/run.sh examples-c/petsc-mumps/run.sh cpp-tests/run.sh fortran/run.sh matlab/run.sh \
+  tests-install/run.sh; do
   echo "== $suite"
   bash "$suite"
 done
