@@ -439,7 +439,7 @@ int main(int argc, char **argv) {
     } else if (hosted) {
         csr nm = csr_from_triplets(&R.c.nm, PART_FULL, base), tm = csr_from_triplets(&R.c.tm, PART_FULL, base);
         fricont_csr nv = csr_view(&nm), tv = csr_view(&tm);
-        st = fricont_problem_new_solve(n, chol_block, &R, 16, &nv, &tv, &prob);
+        st = fricont_problem_new_solve(n, chol_block, &R, NULL, 16, &nv, &tv, &prob);
         free_csr(&nm);
         free_csr(&tm);
         if (st == FRICONT_OK) st = set_case_settings(&R.c, prob);

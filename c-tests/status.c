@@ -708,8 +708,10 @@ static void test_bifurcation(void) {
  * W = B A^-1 B^T = diag(1/2, 1), q(alpha) = B A^-1 f(alpha) = (1/2, alpha): the same path,
  * stick with lambda = (-1, -alpha) up to alpha = 1/2, then slip+ with u_2 = alpha - 1/2. */
 typedef struct {
-    int calls, fail_from, fail_code, fail_times;
+    int calls, fail_from, fail_code, fail_times, finalized;
 } solve_data;
+
+static void solve_finalize(void *user) { ((solve_data *)user)->finalized++; }
 
 /* A^-1 = diag(1/2, 1); fails with fail_code on calls fail_from .. fail_from + fail_times - 1
  * (after scribbling over x, which fricont must restore before a retry). */
@@ -775,18 +777,20 @@ static void test_host_input(void) {
 
     /* a host's solve */
     fricont_csr nm = mk(1, 2, 1, n_rp, n_ci, n_v, 0), tm = mk(1, 2, 1, t_rp, t_ci, t_v, 0);
-    solve_data sd = {0, 0, 0, 0};
-    EXPECT(fricont_problem_new_solve(2, NULL, &sd, 1, &nm, &tm, &p), FRICONT_ERR_NULL, "solve");
-    EXPECT(fricont_problem_new_solve(1, diag_solve, &sd, 1, &nm, &tm, &p), FRICONT_ERR_LENGTH, "N is 1x2");
-    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, 0, &nm, &tm, &p), FRICONT_ERR_LENGTH, "max_block");
-    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, 1, NULL, &tm, &p), FRICONT_ERR_NULL, "N");
+    solve_data sd = {0, 0, 0, 0, 0};
+    EXPECT(fricont_problem_new_solve(2, NULL, &sd, solve_finalize, 1, &nm, &tm, &p), FRICONT_ERR_NULL, "solve");
+    CHECK(sd.finalized == 1, "a failing constructor finalizes the user data at once (%d)", sd.finalized);
+    sd.finalized = 0;
+    EXPECT(fricont_problem_new_solve(1, diag_solve, &sd, NULL, 1, &nm, &tm, &p), FRICONT_ERR_LENGTH, "N is 1x2");
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 0, &nm, &tm, &p), FRICONT_ERR_LENGTH, "max_block");
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 1, NULL, &tm, &p), FRICONT_ERR_NULL, "N");
     /* fatal, recoverable twice, recoverable once (then fine) */
     int codes[3] = {-3, 5, 5}, times[3] = {1, 2, 1};
     fricont_status wants[3] = {FRICONT_ERR_SOLVE_CALLBACK, FRICONT_ERR_SOLVE_CALLBACK, FRICONT_OK};
     const char *needles[3] = {"code -3", "code 5", ""};
     for (int k = 0; k < 3; k++) {
-        solve_data f = {0, 1, codes[k], times[k]};
-        EXPECT(fricont_problem_new_solve(2, diag_solve, &f, 1, &nm, &tm, &p), FRICONT_OK, "");
+        solve_data f = {0, 1, codes[k], times[k], 0};
+        EXPECT(fricont_problem_new_solve(2, diag_solve, &f, NULL, 1, &nm, &tm, &p), FRICONT_OK, "");
         EXPECT(fricont_problem_build(p), wants[k], needles[k]);
         if (wants[k] == FRICONT_OK) {
             double r = 0, r0 = 0;
@@ -796,7 +800,7 @@ static void test_host_input(void) {
         }
         fricont_problem_free(p);
     }
-    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, 1, &nm, &tm, &p), FRICONT_OK, "");
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, solve_finalize, 1, &nm, &tm, &p), FRICONT_OK, "");
     EXPECT(fricont_problem_set_friction(p, 0.5), FRICONT_OK, "");
     EXPECT(fricont_path_new_affine(p, f0, f1, 2, &path), FRICONT_OK, "");
     CHECK(sd.calls == 2, "W by 2 one-column solves, got %d calls", sd.calls);
@@ -820,8 +824,11 @@ static void test_host_input(void) {
     int32_t code = 0;
     EXPECT(fricont_path_callback_code(path, &code), FRICONT_OK, "");
     CHECK(code == -4, "callback code %d after a failing solve", code);
-    fricont_path_free(path);
+    /* the path still needs the solve after the problem handle is gone */
     fricont_problem_free(p);
+    CHECK(sd.finalized == 0, "user data finalized while a path uses the solve");
+    fricont_path_free(path);
+    CHECK(sd.finalized == 1, "user data finalized %d times after the last free", sd.finalized);
 }
 
 /* The library must not start threads in the host program (factorisations and solves run

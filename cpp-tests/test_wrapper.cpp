@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
@@ -129,6 +131,45 @@ std::string check_solution(const casefile::Case &c, const fricont::State &s,
     }
     return "";
 }
+
+// A banded Cholesky of the case's A (an independent solver for the host-solve tests):
+// L is stored row by row over the band of half-width b.
+struct BandCholesky {
+    int64_t n = 0, b = 0;
+    std::vector<double> l;  // l[i * (b + 1) + (i - j)] = L(i, j), i - b <= j <= i
+    explicit BandCholesky(const casefile::Csr &a) : n(a.nrows) {
+        for (int64_t i = 0; i < n; i++)
+            for (int64_t k = a.row_ptr[i]; k < a.row_ptr[i + 1]; k++)
+                b = std::max<int64_t>(b, std::llabs(i - a.col_idx[k]));
+        l.assign(static_cast<std::size_t>(n * (b + 1)), 0.0);
+        for (int64_t i = 0; i < n; i++)
+            for (int64_t k = a.row_ptr[i]; k < a.row_ptr[i + 1]; k++) {
+                int64_t j = a.col_idx[k];
+                if (j <= i) at(i, j) = a.values[k];  // lower triangle (full files are symmetric)
+                else if (a.symmetric) at(j, i) = a.values[k];
+            }
+        for (int64_t i = 0; i < n; i++)
+            for (int64_t j = std::max<int64_t>(0, i - b); j <= i; j++) {
+                double s = at(i, j);
+                for (int64_t k = std::max<int64_t>(std::max<int64_t>(0, i - b), j - b); k < j; k++)
+                    s -= at(i, k) * at(j, k);
+                at(i, j) = i == j ? std::sqrt(s) : s / at(j, j);
+            }
+    }
+    double &at(int64_t i, int64_t j) { return l[static_cast<std::size_t>(i * (b + 1) + (i - j))]; }
+    void solve(double *x) {
+        for (int64_t i = 0; i < n; i++) {
+            double s = x[i];
+            for (int64_t k = std::max<int64_t>(0, i - b); k < i; k++) s -= at(i, k) * x[k];
+            x[i] = s / at(i, i);
+        }
+        for (int64_t i = n - 1; i >= 0; i--) {
+            double s = x[i];
+            for (int64_t k = i + 1; k <= std::min<int64_t>(n - 1, i + b); k++) s -= at(k, i) * x[k];
+            x[i] = s / at(i, i);
+        }
+    }
+};
 
 fricont::Problem make_problem(const casefile::Case &c) {
     fricont::CsrRef a(c.a.nrows, c.a.ncols, c.a.row_ptr, c.a.col_idx, c.a.values);
@@ -313,6 +354,98 @@ int main(int argc, char **argv) {
             status = e.status();
         }
         report("negative friction throws FRICONT_ERR_RANGE", status == FRICONT_ERR_RANGE);
+    }
+
+    // 8. The hosts' constructors: N, T and a solve (a banded Cholesky written here), and
+    //    condensed data (W and q formed with the same solve): the C reference's events;
+    //    u through the solve equals the built-in u; no u from condensed data.
+    {
+        auto chol = std::make_shared<BandCholesky>(c.a);
+        const int64_t n = c.a.nrows, p = c.n.nrows;
+        int64_t blocks = 0, widest = 0;
+        auto solve = [chol, &blocks, &widest](double *x, int64_t nn, int64_t ncols, int64_t ldx) {
+            blocks++;
+            widest = std::max(widest, ncols);
+            for (int64_t j = 0; j < ncols; j++) chol->solve(x + j * ldx);
+            (void)nn;
+        };
+        fricont::CsrRef nr(c.n.nrows, c.n.ncols, c.n.row_ptr, c.n.col_idx, c.n.values);
+        fricont::CsrRef tr(c.t.nrows, c.t.ncols, c.t.row_ptr, c.t.col_idx, c.t.values);
+        fricont::Problem hosted = fricont::Problem::with_solve(n, solve, nr, tr, 8);
+        hosted.set_friction(c.friction);
+        hosted.set_gap(c.gap);
+        fricont::Path h = fricont::Path::affine(hosted, c.f0, c.f1);
+        report("host's solve: W by blocks of at most 8 columns", widest <= 8 && blocks >= (2 * p + 7) / 8,
+               std::to_string(blocks) + " blocks, widest " + std::to_string(widest));
+        h.set_window(c.alpha_start, c.alpha_end);
+        h.start(c.alpha_start);
+        report("host's solve: ends at the window", h.run() == fricont::EndReason::Window);
+        std::vector<fricont::Event> hev = h.events();
+        std::string d = compare(hev, ref, 1e-10, same, ref.size());
+        report("host's solve: events equal the C reference", d.empty() && hev.size() == ref.size(), d);
+        if (!hev.empty() && !ev.empty()) {
+            fricont::State uh = h.event_state(0);
+            fricont::Path own = fricont::Path::affine(prob, c.f0, c.f1);
+            own.set_window(c.alpha_start, c.alpha_end);
+            own.start(c.alpha_start);
+            own.run();
+            fricont::State uo = own.event_state(0);
+            double dmax = 0, umax = 0;
+            for (std::size_t i = 0; i < uo.u.size(); i++) {
+                dmax = std::max(dmax, std::fabs(uo.u[i] - uh.u[i]));
+                umax = std::max(umax, std::fabs(uo.u[i]));
+            }
+            report("host's solve: u at event 1 equals the built-in u",
+                   uh.u.size() == uo.u.size() && dmax <= 1e-10 * umax, std::to_string(dmax / umax));
+        }
+        // condensed: W = B A^-1 B^T and q = B A^-1 f with the banded solve
+        std::vector<double> w(static_cast<std::size_t>(4 * p * p)), q0(2 * p), q1(2 * p);
+        auto rows = [&](const std::vector<double> &x, double *out) {
+            std::vector<double> nx = c.n.apply(x), tx = c.t.apply(x);
+            for (int64_t i = 0; i < p; i++) {
+                out[i] = nx[i];
+                out[p + i] = tx[i];
+            }
+        };
+        for (int64_t k = 0; k < 2 * p; k++) {
+            std::vector<double> e(static_cast<std::size_t>(p), 0.0);
+            e[k % p] = 1.0;
+            std::vector<double> x = k < p ? c.n.apply_t(e) : c.t.apply_t(e);
+            chol->solve(x.data());
+            rows(x, &w[static_cast<std::size_t>(k * 2 * p)]);
+        }
+        std::vector<double> x0 = c.f0, x1 = c.f1;
+        chol->solve(x0.data());
+        chol->solve(x1.data());
+        rows(x0, q0.data());
+        rows(x1, q1.data());
+        fricont::Problem cond = fricont::Problem::condensed(p, w);
+        cond.set_friction(c.friction);
+        cond.set_gap(c.gap);
+        report("condensed: n() is 0", cond.n() == 0 && cond.p() == p);
+        fricont::Path cp = fricont::Path::affine(cond, q0, q1);
+        cp.set_window(c.alpha_start, c.alpha_end);
+        cp.start(c.alpha_start);
+        report("condensed: ends at the window", cp.run() == fricont::EndReason::Window);
+        std::vector<fricont::Event> cev = cp.events();
+        d = compare(cev, ref, 1e-10, same, ref.size());
+        report("condensed: events equal the C reference", d.empty() && cev.size() == ref.size(), d);
+        if (!cev.empty()) {
+            fricont::State cs = cp.event_state(0);
+            report("condensed: states carry no u", cs.u.empty() && cs.residual <= 1e-12,
+                   std::to_string(cs.residual));
+        }
+        // a throwing solve is a fatal solve failure
+        int32_t status = 0;
+        try {
+            fricont::Problem bad = fricont::Problem::with_solve(
+                n, [](double *, int64_t, int64_t, int64_t) { throw std::runtime_error("no"); }, nr, tr);
+            bad.build();
+        } catch (const fricont::Error &e) {
+            status = e.status();
+        }
+        report("a throwing solve gives FRICONT_ERR_SOLVE_CALLBACK", status == FRICONT_ERR_SOLVE_CALLBACK,
+               std::to_string(status));
     }
 
     std::cout << "cpp-tests: " << failures << " failed check(s)\n";

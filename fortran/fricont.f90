@@ -28,7 +28,7 @@
 !> Signs and units: lambda_n <= 0 is compressive; (N u)_i <= g_i is non-penetration;
 !> forces are in the units of A u.
 module fricont
-    use, intrinsic :: iso_c_binding, only: c_int32_t, c_int64_t, c_double, c_bool, c_char, &
+    use, intrinsic :: iso_c_binding, only: c_int32_t, c_int64_t, c_int, c_double, c_bool, c_char, &
         c_ptr, c_funptr, c_null_ptr, c_null_funptr, c_null_char, c_size_t, c_loc, c_funloc, &
         c_associated, c_f_pointer
     use, intrinsic :: iso_fortran_env, only: int32, int64, real64, error_unit
@@ -45,6 +45,7 @@ module fricont
     integer, parameter, public :: FRICONT_ERR_LENGTH = -102
     integer, parameter, public :: FRICONT_ERR_RANGE = -103
     integer, parameter, public :: FRICONT_ERR_ORDER = -104
+    integer, parameter, public :: FRICONT_ERR_UNAVAILABLE = -105
     integer, parameter, public :: FRICONT_ERR_CSR = -201
     integer, parameter, public :: FRICONT_ERR_NONFINITE = -202
     integer, parameter, public :: FRICONT_ERR_NOT_SYMMETRIC = -203
@@ -54,6 +55,7 @@ module fricont
     integer, parameter, public :: FRICONT_ERR_NUMERICAL = -302
     integer, parameter, public :: FRICONT_ERR_CALLBACK = -401
     integer, parameter, public :: FRICONT_ERR_CALLBACK_VALUE = -402
+    integer, parameter, public :: FRICONT_ERR_SOLVE_CALLBACK = -403
     integer, parameter, public :: FRICONT_ERR_PANIC = -501
     integer, parameter, public :: FRICONT_ERR_POISONED = -502
     ! ---- Node classes (fricont_class) ----------------------------------------------------
@@ -73,7 +75,7 @@ module fricont
     integer, parameter, public :: FRICONT_END_BIFURCATION = 4
     integer, parameter, public :: FRICONT_END_FAILED = 5
 
-    public :: fricont_load_fn, fricont_weights_fn
+    public :: fricont_load_fn, fricont_weights_fn, fricont_solve_fn
     public :: fricont_class_name, fricont_end_reason_name, fricont_status_name, fricont_version
 
     !> The error argument: `status` (a negative fricont_status, or FRICONT_OK) and the
@@ -122,6 +124,8 @@ module fricont
     contains
         procedure, private :: problem_create_i32, problem_create_i64
         generic :: create => problem_create_i32, problem_create_i64
+        procedure :: create_condensed => problem_create_condensed
+        procedure :: create_solve => problem_create_solve
         procedure, private :: problem_set_friction_scalar, problem_set_friction_nodes
         generic :: set_friction => problem_set_friction_scalar, problem_set_friction_nodes
         procedure :: set_gap => problem_set_gap
@@ -229,6 +233,15 @@ module fricont
             type(c_ptr), value :: user_data
             integer(c_int32_t) :: code
         end function fricont_weights_fn
+        !> The host's solve with A (see problem%create_solve): overwrite x(1:n, 1:ncols)
+        !> (leading dimension ldx) with A^-1 x; return 0, > 0 (recoverable) or < 0 (fatal).
+        function fricont_solve_fn(user_data, n, ncols, x, ldx) bind(C) result(code)
+            import :: c_int64_t, c_int, c_ptr, c_double
+            type(c_ptr), value :: user_data
+            integer(c_int64_t), value :: n, ncols, ldx
+            real(c_double), intent(inout) :: x(ldx, ncols)
+            integer(c_int) :: code
+        end function fricont_solve_fn
     end interface
 
     ! ---- The C functions (private) -------------------------------------------------------
@@ -270,6 +283,24 @@ module fricont
             type(c_ptr), value :: h
             real(c_double), value :: r
             integer(c_int32_t) :: c_problem_set_r
+        end function
+        function c_problem_new_condensed(p, w, ldw, out) &
+            bind(C, name="fricont_problem_new_condensed")
+            import :: c_int64_t, c_int32_t, c_ptr
+            integer(c_int64_t), value :: p, ldw
+            type(c_ptr), value :: w
+            type(c_ptr), intent(out) :: out
+            integer(c_int32_t) :: c_problem_new_condensed
+        end function
+        function c_problem_new_solve(n, solve, user, free_fn, max_block, nm, t, out) &
+            bind(C, name="fricont_problem_new_solve")
+            import :: c_int64_t, c_int32_t, c_ptr, c_funptr, c_csr
+            integer(c_int64_t), value :: n, max_block
+            type(c_funptr), value :: solve, free_fn
+            type(c_ptr), value :: user
+            type(c_csr), intent(in) :: nm, t
+            type(c_ptr), intent(out) :: out
+            integer(c_int32_t) :: c_problem_new_solve
         end function
         function c_problem_build(h) bind(C, name="fricont_problem_build")
             import :: c_ptr, c_int32_t
@@ -573,6 +604,64 @@ contains
     end function fricont_version
 
     ! ---- Problem -------------------------------------------------------------------------
+
+    !> Creates the problem from condensed data (fricont_problem_new_condensed): w is
+    !> W = B A^-1 B^T (2p x 2p, symmetric positive definite; rows/columns 1..p normal,
+    !> p+1..2p tangential). Loads are then condensed vectors q = B A^-1 f of 2p entries,
+    !> states carry no u (state%u is left unallocated) and n() is 0. W is checked at the
+    !> first build (FRICONT_ERR_NOT_SYMMETRIC, FRICONT_ERR_NOT_SPD, FRICONT_ERR_NONFINITE).
+    subroutine problem_create_condensed(self, w, err)
+        class(fricont_problem), intent(inout) :: self
+        real(real64), intent(in), contiguous, target :: w(:, :)
+        type(fricont_error), intent(out), optional :: err
+        call self%free()
+        if (size(w, 1) /= size(w, 2) .or. mod(size(w, 1), 2) /= 0 .or. size(w, 1) < 2) then
+            call usage_error(FRICONT_ERR_LENGTH, 'fricont_problem%create_condensed: w must '// &
+                             'be 2p x 2p with p >= 1', err)
+            return
+        end if
+        call handle(c_problem_new_condensed(int(size(w, 1)/2, c_int64_t), c_loc(w), &
+                                            int(size(w, 1), c_int64_t), self%h), err, &
+                    'fricont_problem%create_condensed')
+    end subroutine problem_create_condensed
+
+    !> Creates the problem from N, T (CSR, int64 indices, p x n) and the host's own solve
+    !> with A (fricont_problem_new_solve): `solve` is a bind(C) function of the interface
+    !> fricont_solve_fn that overwrites x(1:n, 1:ncols) (leading dimension ldx) with A^-1 x
+    !> and returns 0, > 0 (recoverable: retried once) or < 0 (fatal). `user_data` is
+    !> passed to it unchanged and must stay valid while the problem or a path made from it
+    !> lives. W is formed by 2p solves in blocks of at most `max_block` (default 64)
+    !> columns; u at a point costs one solve. `index_base`: 1 (default) or 0.
+    subroutine problem_create_solve(self, n, solve, user_data, n_ptr, n_col, n_val, &
+                                    t_ptr, t_col, t_val, max_block, index_base, err)
+        class(fricont_problem), intent(inout) :: self
+        integer(int64), intent(in) :: n
+        procedure(fricont_solve_fn) :: solve
+        type(c_ptr), intent(in) :: user_data
+        integer(int64), intent(in), contiguous, target :: n_ptr(:), n_col(:), t_ptr(:), t_col(:)
+        real(real64), intent(in), contiguous, target :: n_val(:), t_val(:)
+        integer, intent(in), optional :: max_block, index_base
+        type(fricont_error), intent(out), optional :: err
+        type(c_csr) :: nm, t
+        integer(c_int64_t) :: base, blk
+        call self%free()
+        base = 1
+        if (present(index_base)) base = index_base
+        blk = 64
+        if (present(max_block)) blk = max_block
+        if (size(n_ptr) < 1 .or. size(t_ptr) < 1 .or. size(n_col) /= size(n_val) .or. &
+            size(t_col) /= size(t_val)) then
+            call usage_error(FRICONT_ERR_LENGTH, 'fricont_problem%create_solve: malformed '// &
+                             'CSR arrays of N or T', err)
+            return
+        end if
+        nm = c_csr(size(n_ptr) - 1, n, size(n_col), c_loc(n_ptr), c_loc_or_null_i(n_col), &
+                   c_loc_or_null_r(n_val), base)
+        t = c_csr(size(t_ptr) - 1, n, size(t_col), c_loc(t_ptr), c_loc_or_null_i(t_col), &
+                  c_loc_or_null_r(t_val), base)
+        call handle(c_problem_new_solve(n, c_funloc(solve), user_data, c_null_funptr, blk, &
+                                        nm, t, self%h), err, 'fricont_problem%create_solve')
+    end subroutine problem_create_solve
 
     !> Creates the problem from A, N, T in CSR (int64 indices). n = size(a_ptr) - 1,
     !> p = size(n_ptr) - 1; N and T have n columns. `storage`: FRICONT_STORAGE_FULL
@@ -999,7 +1088,8 @@ contains
         if (allocated(state%u)) then
             if (size(state%u) /= self%n) deallocate (state%u)
         end if
-        if (.not. allocated(state%u)) allocate (state%u(max(self%n, 1_int64)))
+        ! (no u for a problem made from condensed data: n = 0, u stays unallocated)
+        if (.not. allocated(state%u) .and. self%n > 0) allocate (state%u(self%n))
         if (allocated(state%lambda_n)) then
             if (size(state%lambda_n) /= self%p) deallocate (state%lambda_n)
         end if
@@ -1012,7 +1102,8 @@ contains
             if (size(state%classes) /= self%p) deallocate (state%classes)
         end if
         if (.not. allocated(state%classes)) allocate (state%classes(max(self%p, 1_int64)))
-        cs%u = c_loc(state%u)
+        cs%u = c_null_ptr
+        if (self%n > 0) cs%u = c_loc(state%u)
         cs%u_len = self%n
         cs%lambda_n = c_loc(state%lambda_n)
         cs%lambda_n_len = self%p

@@ -390,6 +390,12 @@ typedef int (*fricont_solve_fn)(void *user,
                                 int64_t ldx);
 
 /**
+ * A finalizer for a callback's `user_data`: called exactly once with `user_data` when
+ * the library no longer needs it (see the `fricont_path_new_*` functions).
+ */
+typedef void (*fricont_free_fn)(void *user_data);
+
+/**
  * A basis-weights callback for `f(α) = Σ_j φ_j(α) f_j`: writes `φ_j(α)` into `phi[0..k)`
  * and `φ_j'(α)` into `dphi[0..k)` (both arrays owned by the library, valid only during
  * the call). `user_data` is the pointer given to `fricont_path_new_basis`. Same return
@@ -400,12 +406,6 @@ typedef int32_t (*fricont_weights_fn)(double alpha,
                                       double *dphi,
                                       int64_t k,
                                       void *user_data);
-
-/**
- * A finalizer for a callback's `user_data`: called exactly once with `user_data` when
- * the library no longer needs it (see the `fricont_path_new_*` functions).
- */
-typedef void (*fricont_free_fn)(void *user_data);
 
 /**
  * A general load callback: writes `f(α)` (or its derivative `f'(α)` when registered as
@@ -712,8 +712,9 @@ fricont_status fricont_problem_new_condensed(int64_t p,
  *
  * * `n`: the number of dofs, ≥ 2p.
  * * `solve`: the host's solve (see `fricont_solve_fn`); not NULL. `user` is passed to
- *   it unchanged (may be NULL) and must stay valid as long as the problem or any path
- *   made from it lives.
+ *   it unchanged (may be NULL) and must stay valid until `free_user` is called.
+ * * `free_user`: NULL, or called exactly once with `user` when the problem and every
+ *   path made from it have been freed (or at once when this function fails).
  * * `max_block`: the largest number of columns fricont passes in one call (≥ 1; fricont
  *   uses at most 256).
  * * `nmat`, `tmat`: N and T (p × n, p ≥ 1), as for `fricont_problem_new`. Not NULL.
@@ -738,6 +739,7 @@ fricont_status fricont_problem_new_condensed(int64_t p,
 fricont_status fricont_problem_new_solve(int64_t n,
                                          fricont_solve_fn solve,
                                          void *user,
+                                         fricont_free_fn free_user,
                                          int64_t max_block,
                                          const struct fricont_csr *nmat,
                                          const struct fricont_csr *tmat,

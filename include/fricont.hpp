@@ -241,6 +241,41 @@ public:
         fricont_csr ca = a.c(), cn = n.c(), ct = t.c();
         detail::check(fricont_problem_new(&ca, static_cast<int32_t>(storage), &cn, &ct, &h_));
     }
+    /// From condensed data (see `fricont_problem_new_condensed`): W = B A⁻¹ Bᵀ, 2p × 2p,
+    /// column-major (`w.size() == 4p²`), symmetric positive definite. Loads are then
+    /// condensed vectors of 2p entries; states carry no u (`State::u` stays empty) and
+    /// `n()` is 0. Throws `Error` (checks of W happen at the first build).
+    static Problem condensed(int64_t p, const std::vector<double> &w) {
+        if (p < 1 || w.size() != static_cast<std::size_t>(4 * p * p))
+            throw Error(FRICONT_ERR_LENGTH,
+                        "fricont::Problem::condensed: W must hold 2p x 2p values, p >= 1");
+        Problem prob;
+        detail::check(fricont_problem_new_condensed(p, w.data(), 2 * p, &prob.h_));
+        return prob;
+    }
+
+    /// The host's solve: overwrite the `ncols` columns of `x` (n rows, column-major,
+    /// leading dimension `ldx`) with A⁻¹ times them. An exception it throws becomes a
+    /// fatal failure (`FRICONT_ERR_SOLVE_CALLBACK`, code −1) of the fricont call in which
+    /// it ran.
+    using SolveFn = std::function<void(double *x, int64_t n, int64_t ncols, int64_t ldx)>;
+
+    /// From N, T (p × n) and the host's own solve with A (see `fricont_problem_new_solve`):
+    /// W is formed by 2p solves in blocks of at most `max_block` columns. The solve is
+    /// kept (copied) until the problem and every path made from it are gone.
+    static Problem with_solve(int64_t n, SolveFn solve, const CsrRef &nm, const CsrRef &t,
+                              int64_t max_block = 64) {
+        if (!solve) throw Error(FRICONT_ERR_NULL, "fricont::Problem::with_solve: no solve");
+        auto *ctx = new SolveFn(std::move(solve));
+        fricont_csr cn = nm.c(), ct = t.c();
+        Problem prob;
+        // The library owns ctx from here: it calls the finalizer (also on failure).
+        detail::check(fricont_problem_new_solve(n, &Problem::solve_trampoline, ctx,
+                                                &Problem::solve_free, max_block, &cn, &ct,
+                                                &prob.h_));
+        return prob;
+    }
+
     Problem(const Problem &) = delete;
     Problem &operator=(const Problem &) = delete;
     Problem(Problem &&o) noexcept : h_(std::exchange(o.h_, nullptr)) {}
@@ -296,6 +331,17 @@ public:
     fricont_problem *get() const noexcept { return h_; }
 
 private:
+    Problem() = default;
+    static int solve_trampoline(void *user, int64_t n, int64_t ncols, double *x, int64_t ldx) {
+        try {
+            (*static_cast<SolveFn *>(user))(x, n, ncols, ldx);
+            return 0;
+        } catch (...) {
+            return -1;
+        }
+    }
+    static void solve_free(void *user) { delete static_cast<SolveFn *>(user); }
+
     int32_t check(int32_t st) const {
         if (st < 0) {
             std::string msg(fricont_problem_error_message(h_, nullptr, 0), '\0');
@@ -485,7 +531,8 @@ private:
         s.lambda_n.resize(static_cast<std::size_t>(p_));
         s.lambda_t.resize(static_cast<std::size_t>(p_));
         std::vector<int32_t> cls(static_cast<std::size_t>(p_));
-        fricont_state st{0.0, 0.0, s.u.data(), n_, s.lambda_n.data(), p_, s.lambda_t.data(),
+        // (no u for a problem made from condensed data: n = 0, pass NULL)
+        fricont_state st{0.0, 0.0, n_ ? s.u.data() : nullptr, n_, s.lambda_n.data(), p_, s.lambda_t.data(),
                          p_, cls.data(), p_};
         check(call(&st));
         s.alpha = st.alpha;

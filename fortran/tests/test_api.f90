@@ -38,6 +38,18 @@ contains
         code = 0
         if (k /= 2) code = 1
     end function sinh_weights
+
+    !> The host's solve for A = diag(2, 1): x := diag(1/2, 1) x.
+    function diag_solve(user_data, n, ncols, x, ldx) bind(C) result(code)
+        use, intrinsic :: iso_c_binding, only: c_int
+        type(c_ptr), value :: user_data
+        integer(c_int64_t), value :: n, ncols, ldx
+        real(c_double), intent(inout) :: x(ldx, ncols)
+        integer(c_int) :: code
+        x(1, :) = 0.5_c_double*x(1, :)
+        code = 0
+        if (n /= 2) code = -1
+    end function diag_solve
 end module api_callbacks
 
 program test_api
@@ -54,6 +66,7 @@ program test_api
     call get_command_argument(1, dir)
     call read_case(trim(dir), c)
     call run_all(c)
+    call host_input()
     write (*, '(a,i0,a)') 'fortran test_api: ', failures, ' failed check(s)'
     if (failures > 0) error stop 1
 
@@ -265,5 +278,56 @@ contains
         call check('status name', &
                    index(fricont_status_name(FRICONT_ERR_CSR), 'FRICONT_ERR_CSR') == 1)
     end subroutine run_all
+
+    !> The hosts' constructors on the block solved by hand (c-tests/status.c): A = diag(2, 1),
+    !> N = [1 0], T = [0 1], F = 1/2, f = (1, alpha): stick with lambda = (-1, -alpha) up to
+    !> alpha = 1/2, then slip+ with u_2 = alpha - 1/2. Condensed: W = diag(1/2, 1),
+    !> q = (1/2, alpha).
+    subroutine host_input()
+        use, intrinsic :: iso_c_binding, only: c_null_ptr
+        type(fricont_problem) :: cp, hp
+        type(fricont_path) :: path
+        type(fricont_event), allocatable :: ev(:)
+        type(fricont_state) :: s
+        type(fricont_error) :: err
+        integer :: reason
+        integer(int64) :: nd, pd
+        real(real64) :: w(2, 2)
+        w = reshape([0.5_real64, 0.0_real64, 0.0_real64, 1.0_real64], [2, 2])
+        call cp%create_condensed(w)
+        call cp%set_friction(0.5_real64)
+        nd = cp%n()
+        pd = cp%p()
+        call check('condensed: n = 0, p = 1', nd == 0 .and. pd == 1)
+        call path%create_affine(cp, [0.5_real64, 0.0_real64], [0.0_real64, 1.0_real64])
+        call path%set_window(0.0_real64, 1.0_real64)
+        call path%start(0.0_real64)
+        call path%run(reason)
+        ev = path%events()
+        call check('condensed: one event at alpha = 1/2', size(ev) == 1 .and. &
+                   abs(ev(1)%alpha - 0.5_real64) <= 1e-15_real64)
+        call path%event_state(1, s, err)
+        call check('condensed: event state without u', err%ok() .and. .not. allocated(s%u) .and. &
+                   abs(s%lambda_n(1) + 1) <= 1e-15_real64 .and. &
+                   abs(s%lambda_t(1) + 0.5_real64) <= 1e-15_real64, err%message)
+        w(1, 2) = 0.1_real64
+        call cp%create_condensed(w)
+        call cp%build(err)
+        call check('condensed: non-symmetric W gives FRICONT_ERR_NOT_SYMMETRIC', &
+                   err%status == FRICONT_ERR_NOT_SYMMETRIC, err%message)
+        call hp%create_solve(2_int64, diag_solve, c_null_ptr, [1_int64, 2_int64], [1_int64], &
+                             [1.0_real64], [1_int64, 2_int64], [2_int64], [1.0_real64], max_block=1)
+        call hp%set_friction(0.5_real64)
+        call path%create_affine(hp, [1.0_real64, 0.0_real64], [0.0_real64, 1.0_real64])
+        call path%set_window(0.0_real64, 1.0_real64)
+        call path%start(0.0_real64)
+        call path%run(reason)
+        ev = path%events()
+        call check('host solve: one event at alpha = 1/2', size(ev) == 1 .and. &
+                   abs(ev(1)%alpha - 0.5_real64) <= 1e-15_real64)
+        call path%current(s)
+        call check('host solve: u at alpha = 1 is (0, 1/2)', allocated(s%u) .and. &
+                   abs(s%u(1)) <= 1e-15_real64 .and. abs(s%u(2) - 0.5_real64) <= 1e-15_real64)
+    end subroutine host_input
 
 end program test_api

@@ -160,9 +160,9 @@ pub struct fricont_solution {
 }
 
 /// The caller's `user_data` with its finalizer, shared by the load closures.
-struct UserData {
-    ptr: *mut c_void,
-    free: fricont_free_fn,
+pub(crate) struct UserData {
+    pub(crate) ptr: *mut c_void,
+    pub(crate) free: fricont_free_fn,
 }
 
 impl Drop for UserData {

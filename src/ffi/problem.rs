@@ -7,6 +7,7 @@ use super::boundary::{
     ErrorSlot, Failure, FfiResult, HasSlot, ffi_boundary, handle_ref, len_of, put, slice_in,
     write_message,
 };
+use super::path::{UserData, fricont_free_fn};
 use super::status::{fricont_status, fricont_storage};
 use crate::condense::{HostSolve, SolveFailure};
 use crate::problem::{CsrMatrix, Problem, ProblemBuilder, Storage};
@@ -336,10 +337,11 @@ pub type fricont_solve_fn = Option<
 >;
 
 /// The C solve as a Rust closure (user data carried across threads: the host answers for
-/// it, as documented on `fricont_solve_fn`).
+/// it, as documented on `fricont_solve_fn`); the finalizer runs when the last problem or
+/// path that uses it is freed.
 struct CSolve {
     f: unsafe extern "C" fn(*mut c_void, i64, i64, *mut f64, i64) -> c_int,
-    user: *mut c_void,
+    user: UserData,
 }
 // SAFETY: fricont calls the host's solve only from threads that called into fricont with
 // this problem, one call at a time (a mutex); the host's contract for `user` covers this.
@@ -354,7 +356,7 @@ impl CSolve {
             // host's function is valid by the contract of `fricont_problem_new_solve`.
             unsafe {
                 (self.f)(
-                    self.user,
+                    self.user.ptr,
                     n as i64,
                     k as i64,
                     x.as_ptr_mut(),
@@ -365,8 +367,15 @@ impl CSolve {
             let mut tmp = x.to_owned();
             let ld = (tmp.col_stride() as i64).max(1);
             // SAFETY: as above, for the contiguous copy.
-            let c =
-                unsafe { (self.f)(self.user, n as i64, k as i64, tmp.as_mut().as_ptr_mut(), ld) };
+            let c = unsafe {
+                (self.f)(
+                    self.user.ptr,
+                    n as i64,
+                    k as i64,
+                    tmp.as_mut().as_ptr_mut(),
+                    ld,
+                )
+            };
             x.copy_from(&tmp);
             c
         };
@@ -393,8 +402,9 @@ impl CSolve {
 ///
 /// * `n`: the number of dofs, ≥ 2p.
 /// * `solve`: the host's solve (see `fricont_solve_fn`); not NULL. `user` is passed to
-///   it unchanged (may be NULL) and must stay valid as long as the problem or any path
-///   made from it lives.
+///   it unchanged (may be NULL) and must stay valid until `free_user` is called.
+/// * `free_user`: NULL, or called exactly once with `user` when the problem and every
+///   path made from it have been freed (or at once when this function fails).
 /// * `max_block`: the largest number of columns fricont passes in one call (≥ 1; fricont
 ///   uses at most 256).
 /// * `nmat`, `tmat`: N and T (p × n, p ≥ 1), as for `fricont_problem_new`. Not NULL.
@@ -420,12 +430,19 @@ pub unsafe extern "C" fn fricont_problem_new_solve(
     n: i64,
     solve: fricont_solve_fn,
     user: *mut c_void,
+    free_user: fricont_free_fn,
     max_block: i64,
     nmat: *const fricont_csr,
     tmat: *const fricont_csr,
     out: *mut *mut fricont_problem,
 ) -> fricont_status {
+    // Owned here so that the finalizer runs even if the call fails.
+    let user = UserData {
+        ptr: user,
+        free: free_user,
+    };
     ffi_boundary!({
+        let user = user;
         if out.is_null() {
             return Err(Failure::null(
                 "out (the fricont_problem ** receiving the handle)",
