@@ -47,6 +47,7 @@ build header_cpp c++ -std=c++17 -O1 -g -Iinclude "${WARN[@]}" c-tests/header_a.c
 build status $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/status.c c-tests/common.c -o "$OUT/status" "${LINK[@]}" -lm
 build paths $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/paths.c c-tests/common.c -o "$OUT/paths" "${LINK[@]}" -lm -lpthread
 build cholmod_ref $C -I/usr/include/suitesparse "${WARN[@]}" c-tests/cholmod_ref.c c-tests/common.c -o "$OUT/cholmod_ref" "${LINK[@]}" -lcholmod -lm
+build oom $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/oom.c c-tests/common.c -o "$OUT/oom" "${LINK[@]}" -lm
 build q1_rectangle $C "${WARN[@]}" examples-c/q1_rectangle.c -o "$OUT/q1_rectangle" "${LINK[@]}" -lm
 
 # --- run -----------------------------------------------------------------------------------
@@ -71,6 +72,8 @@ mkdir -p "$Q1"
 run "header C99" "$OUT/header_c"
 run "header C++17" "$OUT/header_cpp"
 run "status codes" "$OUT/status"
+# Out of memory under a 4 GiB address-space limit: a status, not an abort.
+run "out of memory (ulimit -v 4 GiB, p = 20000)" bash -c "ulimit -v 4000000 && exec '$OUT/oom' 20000"
 if "$OUT/q1_rectangle" --write "$Q1" >"$OUT/q1_rectangle.txt" 2>&1 && grep -q "stick  -> slip+" "$OUT/q1_rectangle.txt"; then
     pass "examples-c/q1_rectangle prints a transition table"
 else
@@ -135,6 +138,7 @@ if command -v valgrind >/dev/null; then
         fail "valgrind examples-c/q1_rectangle"; tail -30 "$OUT/valgrind_q1.txt"
     fi
     run "valgrind status codes" "${VG[@]}" "$OUT/status"
+    run "valgrind out of memory (ulimit -v 8 GiB)" bash -c "ulimit -v 8000000 && exec ${VG[*]} '$OUT/oom' 20000"
     run "valgrind CHOLMOD reference: Q1 example" "${VG[@]}" "$OUT/cholmod_ref" "$Q1"
     run "valgrind CHOLMOD reference: Q1 example, via solve" "${VG[@]}" "$OUT/cholmod_ref" "$Q1" --via solve
     run "valgrind CHOLMOD reference: Q1 example, via condensed" "${VG[@]}" "$OUT/cholmod_ref" "$Q1" --via condensed

@@ -53,6 +53,7 @@ module fricont
     integer, parameter, public :: FRICONT_ERR_RANK_DEFICIENT = -205
     integer, parameter, public :: FRICONT_ERR_SOLVE_FAILED = -301
     integer, parameter, public :: FRICONT_ERR_NUMERICAL = -302
+    integer, parameter, public :: FRICONT_ERR_OUT_OF_MEMORY = -303
     integer, parameter, public :: FRICONT_ERR_CALLBACK = -401
     integer, parameter, public :: FRICONT_ERR_CALLBACK_VALUE = -402
     integer, parameter, public :: FRICONT_ERR_SOLVE_CALLBACK = -403

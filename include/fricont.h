@@ -61,7 +61,8 @@
  *   `FRICONT_FOLD`, `FRICONT_BIFURCATION`, `FRICONT_END`.
  * * negative: an error, in bands by kind: `-1xx` usage (a mistake in the call: NULL
  *   pointer, length, range, order), `-2xx` data (the matrices cannot be used), `-3xx`
- *   numerics, `-4xx` the caller's load callback, `-5xx` internal (a caught panic).
+ *   numerics and resources (memory), `-4xx` the caller's callbacks, `-5xx` internal (a
+ *   caught panic).
  *
  * Every failing call stores a specific one-line message: on the handle it was given
  * (`fricont_problem_error_message`, `fricont_path_error_message`) and, always, in the
@@ -158,6 +159,12 @@ enum fricont_status
      * Numerics: a numerical failure while tracing (the message says which).
      */
     FRICONT_ERR_NUMERICAL = -302,
+    /**
+     * Resources: an allocation failed (the message says what and how many bytes). The
+     * call changed nothing; the handles stay usable (free something, or use a smaller
+     * problem, and call again).
+     */
+    FRICONT_ERR_OUT_OF_MEMORY = -303,
     /**
      * Callback: a load callback returned a nonzero code; the step was aborted and the
      * path ended (reason `FRICONT_END_FAILED`), keeping what it had traced. The code is
@@ -823,9 +830,10 @@ fricont_status fricont_problem_set_r(struct fricont_problem *problem,
 
 /**
  * Validates and factorises the problem now: checks the symmetry of A (full storage),
- * computes a sparse Cholesky factorisation of A and the Delassus operator
- * W = B A⁻¹ Bᵀ (one solve with 2p right-hand sides), and checks that W is positive
- * definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
+ * computes a sparse Cholesky factorisation of A (the dofs B touches ordered last) and the
+ * Delassus operator W = B A⁻¹ Bᵀ from the trailing block of the factor (or by 2p solves
+ * when B's rows are wide, or with the host's solve; a condensed W is checked instead),
+ * and checks that W is positive definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
  * needed; call it to see data errors early or to time the set-up. A no-op when nothing
  * changed since the last build.
  *
@@ -833,7 +841,10 @@ fricont_status fricont_problem_set_r(struct fricont_problem *problem,
  * `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
  * the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n), `FRICONT_ERR_RANGE`
  * (an r set outside [1e-6, 1e6] × the default 2p / trace(W)),
- * `FRICONT_ERR_NUMERICAL` (out of memory), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_OUT_OF_MEMORY` (the factor, W or a copy of the data cannot be allocated:
+ * the message says how much was asked; the handle stays usable),
+ * `FRICONT_ERR_SOLVE_CALLBACK` (the host's solve failed), `FRICONT_ERR_POISONED`,
+ * `FRICONT_ERR_PANIC`.
  *
  * # Safety
  * `problem` is NULL or a live handle.
@@ -899,8 +910,10 @@ size_t fricont_problem_error_message(const struct fricont_problem *problem,
  * transition point is found exactly.
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_LENGTH` (`n` ≠ the problem's n),
- * `FRICONT_ERR_NONFINITE` (NaN or infinity in f0 or f1), the errors of
- * `fricont_problem_build`, `FRICONT_ERR_POISONED` (problem), `FRICONT_ERR_PANIC`. Error
+ * `FRICONT_ERR_NONFINITE` (NaN or infinity in f0 or f1), `FRICONT_ERR_OUT_OF_MEMORY`
+ * (the path's dense working set, about eight 2p × 2p matrices, cannot be allocated),
+ * the errors of `fricont_problem_build`, `FRICONT_ERR_POISONED` (problem),
+ * `FRICONT_ERR_PANIC`. Error
  * messages go to the problem handle and to `fricont_last_error_message`.
  *
  * # Safety

@@ -30,7 +30,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, try_vec, try_zeros};
 use crate::problem::CsrMatrix;
 
 /// Columns of `Bᵀ` solved at once when forming `W` by solves (bounds the dense workspace
@@ -122,7 +122,8 @@ impl HostSolve {
         while c0 < k {
             let kb = self.max_block.min(k - c0);
             let mut xb = x.as_mut().subcols_mut(c0, kb);
-            let rhs = xb.to_owned();
+            let mut rhs = try_zeros(xb.nrows(), kb, "a copy of the right-hand sides")?;
+            rhs.copy_from(&xb);
             let mut res = f(xb.as_mut());
             if let Err(e) = &res
                 && e.code > 0
@@ -208,7 +209,12 @@ impl Delassus {
             ..Default::default()
         };
         let t_analyse = std::time::Instant::now();
-        let symbolic_err = |e| Error::Numerical(format!("symbolic Cholesky of A: {e:?}"));
+        let symbolic_err = |e: faer::sparse::FaerError| match e {
+            faer::sparse::FaerError::OutOfMemory => Error::OutOfMemory(
+                "the symbolic Cholesky factorisation of A (ordering and structure of L)".into(),
+            ),
+            e => Error::Numerical(format!("symbolic Cholesky of A: {e:?}")),
+        };
         let amd = factorize_symbolic_cholesky(symb, Side::Upper, SymmetricOrdering::Amd, params)
             .map_err(symbolic_err)?;
         // The dofs B touches, and whether W comes from the trailing block of the factor.
@@ -238,13 +244,17 @@ impl Delassus {
         };
         let analyse_s = t_analyse.elapsed().as_secs_f64();
         let t_factorise = std::time::Instant::now();
-        let mut l_values = vec![0.0f64; symbolic.len_val()];
+        let mut l_values = try_vec(symbolic.len_val(), 0.0f64, "the Cholesky factor L of A")?;
         let par = Par::Seq;
         {
             let mut mem = MemBuffer::try_new(
                 symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
             )
-            .map_err(|_| Error::Numerical("out of memory for the Cholesky of A".into()))?;
+            .map_err(|_| {
+                Error::OutOfMemory(
+                    "the workspace of the numeric Cholesky factorisation of A".into(),
+                )
+            })?;
             let res = symbolic.factorize_numeric_llt::<f64>(
                 &mut l_values,
                 a_csc,
@@ -285,7 +295,11 @@ impl Delassus {
             _ => 0,
         };
         let t_w = std::time::Instant::now();
-        this.w = match trailing.then(|| this.w_by_trailing_block(s)).flatten() {
+        this.w = match trailing
+            .then(|| this.w_by_trailing_block(s))
+            .transpose()?
+            .flatten()
+        {
             Some(w) => {
                 this.trailing = true;
                 w
@@ -300,23 +314,26 @@ impl Delassus {
     /// `W = Zᵀ Z`, `Z = L_SS⁻¹ B_Sᵀ`, from the trailing s × s block of a supernodal factor
     /// whose ordering puts the s dofs that B touches last. None when the factor does not
     /// have that form (then W is formed by solves).
-    fn w_by_trailing_block(&self, s: usize) -> Option<Mat<f64>> {
+    fn w_by_trailing_block(&self, s: usize) -> Result<Option<Mat<f64>>> {
         let n = self.n;
         let m = self.b.nrows();
         let Operator::Cholesky { symbolic, l_values } = &self.op else {
-            return None;
+            return Ok(None);
         };
         let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw() else {
-            return None;
+            return Ok(None);
         };
-        let inv = symbolic.perm()?.arrays().1;
+        let Some(perm) = symbolic.perm() else {
+            return Ok(None);
+        };
+        let inv = perm.arrays().1;
         let first = n - s;
         // Every dof B touches must sit in the trailing block.
         if self.b.col_idx().iter().any(|&j| inv[j] < first) {
-            return None;
+            return Ok(None);
         }
         let llt = SupernodalLltRef::<'_, usize, f64>::new(sym, l_values);
-        let mut lss = Mat::<f64>::zeros(s, s);
+        let mut lss = try_zeros(s, s, "the trailing block L_SS of the factor")?;
         for k in 0..sym.n_supernodes() {
             let node = llt.supernode(k);
             let start = node.start();
@@ -336,7 +353,7 @@ impl Delassus {
                 }
             }
         }
-        let mut z = Mat::<f64>::zeros(s, m);
+        let mut z = try_zeros(s, m, "Z = L_SS^-1 B_S^T")?;
         for i in 0..m {
             for (j, v) in self.b.row(i) {
                 z[(inv[j] - first, i)] = v;
@@ -347,7 +364,7 @@ impl Delassus {
             z.as_mut(),
             Par::Seq,
         );
-        let mut w = Mat::<f64>::zeros(m, m);
+        let mut w = try_zeros(m, m, "W")?;
         faer::linalg::matmul::matmul(
             w.as_mut(),
             Accum::Replace,
@@ -357,7 +374,7 @@ impl Delassus {
             Par::Seq,
         );
         symmetrise(&mut w);
-        Some(w)
+        Ok(Some(w))
     }
 
     /// `W = B A⁻¹ Bᵀ` by 2p solves with the factor of A, in blocks of columns: how W is
@@ -373,8 +390,8 @@ impl Delassus {
     /// `B A⁻¹ Bᵀ` by solves with `block` columns at a time, not symmetrised.
     fn w_by_solves_raw(&self, block: usize) -> Result<Mat<f64>> {
         let m = self.b.nrows();
-        let mut w = Mat::<f64>::zeros(m, m);
-        let mut x = Mat::<f64>::zeros(self.n, block.min(m));
+        let mut w = try_zeros(m, m, "W")?;
+        let mut x = try_zeros(self.n, block.min(m), "a block of solves for W")?;
         let mut col0 = 0;
         while col0 < m {
             let k = block.min(m - col0);
@@ -421,6 +438,7 @@ impl Delassus {
                 d / self.w[(j, j)]
             ))
         };
+        crate::problem::preflight(m * m * 8, "the Cholesky factor of W")?;
         let llt = match self.w.llt(Side::Lower) {
             Ok(llt) => llt,
             Err(DenseLltError::NonPositivePivot { index }) => {

@@ -71,10 +71,50 @@ pub enum Error {
         /// Why.
         message: String,
     },
+    /// An allocation failed: the message says what and how many bytes were asked for.
+    /// Nothing was changed; the handle stays usable.
+    #[error("out of memory: {0}")]
+    OutOfMemory(String),
     /// A numerical failure during tracing (singular piece where none may be, …).
     #[error("numerical failure: {0}")]
     Numerical(String),
     /// A call made in the wrong order (e.g. stepping a path that was not started).
     #[error("usage: {0}")]
     Usage(String),
+}
+
+/// A vector of `len` copies of `value`, or [`Error::OutOfMemory`] naming `what` and the
+/// bytes asked for (instead of aborting the process).
+pub(crate) fn try_vec<T: Clone>(len: usize, value: T, what: &str) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len)
+        .map_err(|_| oom(what, len, std::mem::size_of::<T>()))?;
+    v.resize(len, value);
+    Ok(v)
+}
+
+/// An empty vector with room for `len` elements, or [`Error::OutOfMemory`].
+pub(crate) fn try_with_capacity<T>(len: usize, what: &str) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len)
+        .map_err(|_| oom(what, len, std::mem::size_of::<T>()))?;
+    Ok(v)
+}
+
+/// A zero `rows × cols` matrix, or [`Error::OutOfMemory`].
+pub(crate) fn try_zeros(rows: usize, cols: usize, what: &str) -> Result<faer::Mat<f64>> {
+    let mut m = faer::Mat::<f64>::new();
+    m.try_reserve(rows, cols)
+        .map_err(|_| oom(what, rows.saturating_mul(cols), 8))?;
+    m.resize_with(rows, cols, |_, _| 0.0);
+    Ok(m)
+}
+
+/// The error for `count` elements of `size` bytes.
+pub(crate) fn oom(what: &str, count: usize, size: usize) -> Error {
+    let bytes = count as f64 * size as f64;
+    Error::OutOfMemory(format!(
+        "{what}: {count} values ({:.3} GiB) could not be allocated",
+        bytes / (1u64 << 30) as f64
+    ))
 }

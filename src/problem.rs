@@ -6,7 +6,7 @@
 //! any number of [`crate::path::Path`]s.
 
 use crate::condense::{Delassus, HostSolve};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, try_with_capacity, try_zeros};
 use faer::Mat;
 
 /// A sparse matrix in compressed sparse row form, 0-based, validated: row pointers start
@@ -69,7 +69,7 @@ impl CsrMatrix {
             )));
         }
         let nnz = values.len();
-        let mut rp = Vec::with_capacity(nrows + 1);
+        let mut rp = try_with_capacity(nrows + 1, &format!("{name}: row pointers"))?;
         for (i, &r) in row_ptr.iter().enumerate() {
             // saturating: i64::MIN - 1 must be "out of range", not an overflow
             let r0 = r.saturating_sub(index_base);
@@ -94,8 +94,8 @@ impl CsrMatrix {
                 rp[nrows]
             )));
         }
-        let mut ci = Vec::with_capacity(nnz);
-        let mut vals = Vec::with_capacity(nnz);
+        let mut ci = try_with_capacity(nnz, &format!("{name}: column indices"))?;
+        let mut vals = try_with_capacity(nnz, &format!("{name}: values"))?;
         let mut row: Vec<(usize, f64)> = Vec::new();
         for i in 0..nrows {
             row.clear();
@@ -153,7 +153,9 @@ impl CsrMatrix {
         ncols: usize,
         triplets: &[(usize, usize, f64)],
     ) -> Result<Self> {
-        let mut t: Vec<(usize, usize, f64)> = triplets.to_vec();
+        let mut t: Vec<(usize, usize, f64)> =
+            try_with_capacity(triplets.len(), &format!("{name}: entries"))?;
+        t.extend_from_slice(triplets);
         for &(i, j, v) in &t {
             if i >= nrows || j >= ncols {
                 return Err(Error::Csr(format!(
@@ -171,9 +173,9 @@ impl CsrMatrix {
             }
         }
         t.sort_by_key(|e| (e.0, e.1));
-        let mut row_ptr = vec![0usize; nrows + 1];
-        let mut col_idx = Vec::with_capacity(t.len());
-        let mut values: Vec<f64> = Vec::with_capacity(t.len());
+        let mut row_ptr = crate::error::try_vec(nrows + 1, 0usize, name)?;
+        let mut col_idx = try_with_capacity(t.len(), &format!("{name}: column indices"))?;
+        let mut values: Vec<f64> = try_with_capacity(t.len(), &format!("{name}: values"))?;
         let mut last: Option<(usize, usize)> = None;
         for (i, j, v) in t {
             if last == Some((i, j)) {
@@ -520,6 +522,14 @@ impl ProblemBuilder {
         }
         let (a, b, node_scale, delassus) = match self.source {
             Source::Matrix { a, storage, n, t } => {
+                // The copies of A made below (both triangles, the lower one, a transpose)
+                // and the per-dof arrays of the ordering, asked for at once so that a
+                // problem too large for the memory fails here cleanly instead of aborting
+                // in an allocation further on.
+                preflight(
+                    4 * a.nnz() * 16 + 8 * n_dofs * 8,
+                    "the copies of A and the ordering",
+                )?;
                 let (lower, full_a) = lower_and_full(&a, storage)?;
                 let (b, node_scale) = equilibrated_b(&n, &t, n_dofs)?;
                 let del = Delassus::new(&lower, &b)?;
@@ -638,7 +648,12 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
         .map(|i| w[(i, i)].max(w[(p + i, p + i)]).sqrt())
         .collect();
     let sc = |k: usize| node_scale[k % p];
-    let w_int = Mat::<f64>::from_fn(m, m, |i, j| 0.5 * (w[(i, j)] + w[(j, i)]) / (sc(i) * sc(j)));
+    let mut w_int = try_zeros(m, m, "the equilibrated W")?;
+    for j in 0..m {
+        for i in 0..m {
+            w_int[(i, j)] = 0.5 * (w[(i, j)] + w[(j, i)]) / (sc(i) * sc(j));
+        }
+    }
     let pivot_err = |j: usize, d: f64| {
         Error::WNotSpd(format!(
             "the Cholesky factorisation of W fails at {} (relative pivot {d:e}; W must be symmetric positive definite: is B = [N; T] of full row rank?)",
@@ -792,6 +807,14 @@ fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatr
             Ok((lo, full))
         }
     }
+}
+
+/// Asks for `bytes` at once and gives them back: [`Error::OutOfMemory`] naming `what` when
+/// the allocation fails (the process keeps running).
+pub(crate) fn preflight(bytes: usize, what: &str) -> Result<()> {
+    let mut v: Vec<u8> = Vec::new();
+    v.try_reserve_exact(bytes)
+        .map_err(|_| crate::error::oom(what, bytes, 1))
 }
 
 /// The accepted range of `r / r0` (r0 = [`Problem::default_r`]). Solutions do not

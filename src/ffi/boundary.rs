@@ -114,6 +114,7 @@ impl From<Error> for Failure {
             Error::Load { code, .. } => (FRICONT_ERR_CALLBACK, Some(*code)),
             Error::SolveFailed { .. } => (FRICONT_ERR_SOLVE_FAILED, None),
             Error::Numerical(_) => (FRICONT_ERR_NUMERICAL, None),
+            Error::OutOfMemory(_) => (FRICONT_ERR_OUT_OF_MEMORY, None),
             Error::Usage(_) => (FRICONT_ERR_ORDER, None),
         };
         Self {

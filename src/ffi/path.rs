@@ -369,8 +369,10 @@ unsafe fn new_path(
 /// transition point is found exactly.
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_LENGTH` (`n` ≠ the problem's n),
-/// `FRICONT_ERR_NONFINITE` (NaN or infinity in f0 or f1), the errors of
-/// `fricont_problem_build`, `FRICONT_ERR_POISONED` (problem), `FRICONT_ERR_PANIC`. Error
+/// `FRICONT_ERR_NONFINITE` (NaN or infinity in f0 or f1), `FRICONT_ERR_OUT_OF_MEMORY`
+/// (the path's dense working set, about eight 2p × 2p matrices, cannot be allocated),
+/// the errors of `fricont_problem_build`, `FRICONT_ERR_POISONED` (problem),
+/// `FRICONT_ERR_PANIC`. Error
 /// messages go to the problem handle and to `fricont_last_error_message`.
 ///
 /// # Safety

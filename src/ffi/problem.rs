@@ -316,7 +316,12 @@ pub unsafe extern "C" fn fricont_problem_new_condensed(
             })?;
         // SAFETY: valid for `total` reads by contract.
         let wv = unsafe { slice_in(w, total, "w") }?;
-        let wm = faer::Mat::<f64>::from_fn(m, m, |i, j| wv[i + j * ld]);
+        let mut wm = crate::error::try_zeros(m, m, "a copy of W")?;
+        for j in 0..m {
+            for i in 0..m {
+                wm[(i, j)] = wv[i + j * ld];
+            }
+        }
         // SAFETY: `out` is valid (checked above).
         unsafe { new_handle(out, 0, pn, ProblemBuilder::condensed(wm)) }
     })
@@ -663,9 +668,10 @@ pub unsafe extern "C" fn fricont_problem_set_r(
 }
 
 /// Validates and factorises the problem now: checks the symmetry of A (full storage),
-/// computes a sparse Cholesky factorisation of A and the Delassus operator
-/// W = B A⁻¹ Bᵀ (one solve with 2p right-hand sides), and checks that W is positive
-/// definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
+/// computes a sparse Cholesky factorisation of A (the dofs B touches ordered last) and the
+/// Delassus operator W = B A⁻¹ Bᵀ from the trailing block of the factor (or by 2p solves
+/// when B's rows are wide, or with the host's solve; a condensed W is checked instead),
+/// and checks that W is positive definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
 /// needed; call it to see data errors early or to time the set-up. A no-op when nothing
 /// changed since the last build.
 ///
@@ -673,7 +679,10 @@ pub unsafe extern "C" fn fricont_problem_set_r(
 /// `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
 /// the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n), `FRICONT_ERR_RANGE`
 /// (an r set outside [1e-6, 1e6] × the default 2p / trace(W)),
-/// `FRICONT_ERR_NUMERICAL` (out of memory), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// `FRICONT_ERR_OUT_OF_MEMORY` (the factor, W or a copy of the data cannot be allocated:
+/// the message says how much was asked; the handle stays usable),
+/// `FRICONT_ERR_SOLVE_CALLBACK` (the host's solve failed), `FRICONT_ERR_POISONED`,
+/// `FRICONT_ERR_PANIC`.
 ///
 /// # Safety
 /// `problem` is NULL or a live handle.

@@ -20,7 +20,8 @@ pub const FRICONT_VERSION_PATCH: c_int = 0;
 ///   `FRICONT_FOLD`, `FRICONT_BIFURCATION`, `FRICONT_END`.
 /// * negative: an error, in bands by kind: `-1xx` usage (a mistake in the call: NULL
 ///   pointer, length, range, order), `-2xx` data (the matrices cannot be used), `-3xx`
-///   numerics, `-4xx` the caller's load callback, `-5xx` internal (a caught panic).
+///   numerics and resources (memory), `-4xx` the caller's callbacks, `-5xx` internal (a
+///   caught panic).
 ///
 /// Every failing call stores a specific one-line message: on the handle it was given
 /// (`fricont_problem_error_message`, `fricont_path_error_message`) and, always, in the
@@ -81,6 +82,10 @@ pub enum fricont_status {
     FRICONT_ERR_SOLVE_FAILED = -301,
     /// Numerics: a numerical failure while tracing (the message says which).
     FRICONT_ERR_NUMERICAL = -302,
+    /// Resources: an allocation failed (the message says what and how many bytes). The
+    /// call changed nothing; the handles stay usable (free something, or use a smaller
+    /// problem, and call again).
+    FRICONT_ERR_OUT_OF_MEMORY = -303,
     /// Callback: a load callback returned a nonzero code; the step was aborted and the
     /// path ended (reason `FRICONT_END_FAILED`), keeping what it had traced. The code is
     /// returned by `fricont_path_callback_code`.
@@ -103,7 +108,7 @@ pub enum fricont_status {
 
 impl fricont_status {
     /// Every status, for tests and `fricont_status_str`.
-    pub const ALL: [fricont_status; 22] = {
+    pub const ALL: [fricont_status; 23] = {
         use fricont_status::*;
         [
             FRICONT_OK,
@@ -123,6 +128,7 @@ impl fricont_status {
             FRICONT_ERR_RANK_DEFICIENT,
             FRICONT_ERR_SOLVE_FAILED,
             FRICONT_ERR_NUMERICAL,
+            FRICONT_ERR_OUT_OF_MEMORY,
             FRICONT_ERR_CALLBACK,
             FRICONT_ERR_CALLBACK_VALUE,
             FRICONT_ERR_SOLVE_CALLBACK,
@@ -158,6 +164,7 @@ impl fricont_status {
             }
             FRICONT_ERR_SOLVE_FAILED => "FRICONT_ERR_SOLVE_FAILED: the fixed-alpha solve failed\0",
             FRICONT_ERR_NUMERICAL => "FRICONT_ERR_NUMERICAL: a numerical failure while tracing\0",
+            FRICONT_ERR_OUT_OF_MEMORY => "FRICONT_ERR_OUT_OF_MEMORY: an allocation failed\0",
             FRICONT_ERR_CALLBACK => {
                 "FRICONT_ERR_CALLBACK: a load callback returned a nonzero code\0"
             }

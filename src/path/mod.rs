@@ -451,6 +451,13 @@ impl Path {
                 opts.zero_tol
             )));
         }
+        // The dense working set of a path: about eight m × m matrices at its peak (the
+        // factorised base piece, its factors, |W|, the fixed-α solver's Jacobians).
+        let m = 2 * problem.p();
+        crate::problem::preflight(
+            m.saturating_mul(m).saturating_mul(8 * 8),
+            "the dense working set of a path (about 8 matrices of 2p x 2p)",
+        )?;
         let load = BoundLoad::new(load, problem.delassus())?;
         Ok(Path {
             problem,
