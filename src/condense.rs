@@ -194,7 +194,11 @@ impl Delassus {
     /// is not numerically positive definite (a pivot of its Cholesky factor below 1e-12
     /// of the corresponding diagonal entry), [`Error::Numerical`] when faer runs out of
     /// memory.
-    pub fn new(a_lower: &CsrMatrix, b: &CsrMatrix) -> Result<Self> {
+    ///
+    /// `par`: the parallelism of the numeric factorisation and of forming W
+    /// (`Par::Seq`, or `Par::rayon(n)` inside a private rayon pool, see
+    /// [`crate::ProblemBuilder::threads`]).
+    pub fn new(a_lower: &CsrMatrix, b: &CsrMatrix, par: Par) -> Result<Self> {
         let n = a_lower.nrows();
         // CSR of the lower triangle == CSC of the upper triangle.
         let symb =
@@ -245,7 +249,6 @@ impl Delassus {
         let analyse_s = t_analyse.elapsed().as_secs_f64();
         let t_factorise = std::time::Instant::now();
         let mut l_values = try_vec(symbolic.len_val(), 0.0f64, "the Cholesky factor L of A")?;
-        let par = Par::Seq;
         {
             let mut mem = MemBuffer::try_new(
                 symbolic.factorize_numeric_llt_scratch::<f64>(par, Default::default()),
@@ -296,7 +299,7 @@ impl Delassus {
         };
         let t_w = std::time::Instant::now();
         this.w = match trailing
-            .then(|| this.w_by_trailing_block(s))
+            .then(|| this.w_by_trailing_block(s, par))
             .transpose()?
             .flatten()
         {
@@ -314,7 +317,7 @@ impl Delassus {
     /// `W = Zᵀ Z`, `Z = L_SS⁻¹ B_Sᵀ`, from the trailing s × s block of a supernodal factor
     /// whose ordering puts the s dofs that B touches last. None when the factor does not
     /// have that form (then W is formed by solves).
-    fn w_by_trailing_block(&self, s: usize) -> Result<Option<Mat<f64>>> {
+    fn w_by_trailing_block(&self, s: usize, par: Par) -> Result<Option<Mat<f64>>> {
         let n = self.n;
         let m = self.b.nrows();
         let Operator::Cholesky { symbolic, l_values } = &self.op else {
@@ -362,7 +365,7 @@ impl Delassus {
         faer::linalg::triangular_solve::solve_lower_triangular_in_place(
             lss.as_ref(),
             z.as_mut(),
-            Par::Seq,
+            par,
         );
         let mut w = try_zeros(m, m, "W")?;
         faer::linalg::matmul::matmul(
@@ -371,7 +374,7 @@ impl Delassus {
             z.transpose(),
             z.as_ref(),
             1.0,
-            Par::Seq,
+            par,
         );
         symmetrise(&mut w);
         Ok(Some(w))
@@ -439,13 +442,12 @@ impl Delassus {
             ))
         };
         crate::problem::preflight(m * m * 8, "the Cholesky factor of W")?;
-        let llt = match self.w.llt(Side::Lower) {
-            Ok(llt) => llt,
+        let l = match crate::dense::llt_lower(self.w.as_ref()) {
+            Ok(l) => l,
             Err(DenseLltError::NonPositivePivot { index }) => {
                 return Err(dependent(index.min(m.saturating_sub(1)), 0.0));
             }
         };
-        let l = llt.L();
         for j in 0..m {
             let d = l[(j, j)] * l[(j, j)];
             if d <= 1e-12 * self.w[(j, j)] {

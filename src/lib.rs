@@ -47,6 +47,7 @@
 
 pub mod class;
 pub mod condense;
+mod dense;
 pub mod error;
 pub mod ffi;
 pub mod load;

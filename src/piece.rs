@@ -282,7 +282,7 @@ pub(crate) fn shift_gap(q: &[f64], gap: &[f64]) -> Vec<f64> {
 
 /// Result of an LU with partial pivoting: solves and the sign of the determinant.
 pub(crate) struct DenseLu {
-    lu: faer::linalg::solvers::PartialPivLu<f64>,
+    lu: crate::dense::Lu,
     /// Sign of the determinant (0 when a pivot is exactly 0).
     pub det_sign: i8,
     /// min |U_ii| / max |U_ii|: a cheap singularity indicator.
@@ -291,10 +291,10 @@ pub(crate) struct DenseLu {
 
 impl DenseLu {
     pub fn new(a: MatRef<'_, f64>) -> Self {
-        let lu = a.partial_piv_lu();
-        let u = lu.U();
+        let lu = crate::dense::partial_piv_lu(a);
+        let u = &lu.u;
         let n = u.nrows();
-        let mut sign: i8 = perm_parity(lu.P().arrays().0);
+        let mut sign: i8 = perm_parity(&lu.row_fwd);
         let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
         for i in 0..n {
             let v = u[(i, i)];
@@ -315,7 +315,6 @@ impl DenseLu {
     }
 
     pub fn solve(&self, b: &[f64]) -> Vec<f64> {
-        use faer::linalg::solvers::Solve;
         let n = b.len();
         let mut x = b.to_vec();
         let xm = faer::MatMut::from_column_major_slice_mut(&mut x, n, 1);
@@ -370,11 +369,12 @@ impl PieceLu {
     /// `1e-13` of the first): the piece is not a curve there.
     pub fn new(j: MatRef<'_, f64>) -> Option<Self> {
         let m = j.nrows();
-        let lu = j.full_piv_lu();
-        let u = lu.U().to_owned();
-        let l = lu.L().to_owned();
-        let p_fwd: Vec<usize> = lu.P().arrays().0.to_vec();
-        let q_fwd: Vec<usize> = lu.Q().arrays().0.to_vec();
+        let crate::dense::Lu {
+            l,
+            u,
+            row_fwd: p_fwd,
+            col_fwd: q_fwd,
+        } = crate::dense::full_piv_lu(j);
         let u00 = if m > 0 { u[(0, 0)].abs() } else { 1.0 };
         if m > 0 && u[(m - 1, m - 1)].abs() <= 1e-13 * u00 {
             return None;

@@ -1,0 +1,138 @@
+//! Dense LU and Cholesky factorisations on the calling thread.
+//!
+//! faer's high-level solvers (`Mat::llt`, `partial_piv_lu`, …) read faer's *global*
+//! parallelism setting, which with faer's `rayon` feature (needed for the problem's
+//! `threads` option) defaults to rayon's global pool: calling them would start a thread
+//! pool inside the host program. These wrappers call faer's factorisation kernels with
+//! `Par::Seq`; the only threads fricont ever starts are the private pool of
+//! [`crate::ProblemBuilder::threads`], for the set-up.
+
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::llt::factor::{LltError, cholesky_in_place, cholesky_in_place_scratch};
+use faer::linalg::lu::{full_pivoting, partial_pivoting};
+use faer::linalg::triangular_solve::{
+    solve_unit_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Mat, MatMut, MatRef, Par};
+
+/// `P A Q = L U` (square A): `L` unit lower, `U` upper; row `i` of `P A` is row
+/// `row_fwd[i]` of A, column `j` of `A Q` is column `col_fwd[j]` of A (identity for
+/// partial pivoting).
+pub(crate) struct Lu {
+    pub l: Mat<f64>,
+    pub u: Mat<f64>,
+    pub row_fwd: Vec<usize>,
+    pub col_fwd: Vec<usize>,
+}
+
+fn split(lu: Mat<f64>) -> (Mat<f64>, Mat<f64>) {
+    let (m, n) = lu.shape();
+    let k = m.min(n);
+    let l = Mat::from_fn(m, k, |i, j| match i.cmp(&j) {
+        std::cmp::Ordering::Greater => lu[(i, j)],
+        std::cmp::Ordering::Equal => 1.0,
+        std::cmp::Ordering::Less => 0.0,
+    });
+    let u = Mat::from_fn(k, n, |i, j| if i <= j { lu[(i, j)] } else { 0.0 });
+    (l, u)
+}
+
+/// LU with partial (row) pivoting of an m × n matrix.
+pub(crate) fn partial_piv_lu(a: MatRef<'_, f64>) -> Lu {
+    let (m, n) = a.shape();
+    let mut lu = a.to_owned();
+    let mut fwd = vec![0usize; m];
+    let mut bwd = vec![0usize; m];
+    let par = Par::Seq;
+    let mut mem = MemBuffer::new(partial_pivoting::factor::lu_in_place_scratch::<usize, f64>(
+        m,
+        n,
+        par,
+        Default::default(),
+    ));
+    partial_pivoting::factor::lu_in_place(
+        lu.as_mut(),
+        &mut fwd,
+        &mut bwd,
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    );
+    let (l, u) = split(lu);
+    Lu {
+        l,
+        u,
+        row_fwd: fwd,
+        col_fwd: (0..n).collect(),
+    }
+}
+
+/// LU with full (row and column) pivoting of an m × n matrix.
+pub(crate) fn full_piv_lu(a: MatRef<'_, f64>) -> Lu {
+    let (m, n) = a.shape();
+    let mut lu = a.to_owned();
+    let (mut rf, mut rb) = (vec![0usize; m], vec![0usize; m]);
+    let (mut cf, mut cb) = (vec![0usize; n], vec![0usize; n]);
+    let par = Par::Seq;
+    let mut mem = MemBuffer::new(full_pivoting::factor::lu_in_place_scratch::<usize, f64>(
+        m,
+        n,
+        par,
+        Default::default(),
+    ));
+    full_pivoting::factor::lu_in_place(
+        lu.as_mut(),
+        &mut rf,
+        &mut rb,
+        &mut cf,
+        &mut cb,
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    );
+    let (l, u) = split(lu);
+    Lu {
+        l,
+        u,
+        row_fwd: rf,
+        col_fwd: cf,
+    }
+}
+
+impl Lu {
+    /// Solves `A X = B` in place for a square A factorised with partial pivoting.
+    pub(crate) fn solve_in_place(&self, mut rhs: MatMut<'_, f64>) {
+        let n = rhs.nrows();
+        for c in 0..rhs.ncols() {
+            let b: Vec<f64> = (0..n).map(|i| rhs[(self.row_fwd[i], c)]).collect();
+            for (i, v) in b.into_iter().enumerate() {
+                rhs[(i, c)] = v;
+            }
+        }
+        solve_unit_lower_triangular_in_place(self.l.as_ref(), rhs.as_mut(), Par::Seq);
+        solve_upper_triangular_in_place(self.u.as_ref(), rhs.as_mut(), Par::Seq);
+        // (partial pivoting: no column permutation)
+    }
+}
+
+/// The Cholesky factor `L` (lower, `A = L Lᵀ`) of a symmetric matrix given by its lower
+/// triangle. Errors: a non-positive pivot.
+pub(crate) fn llt_lower(a: MatRef<'_, f64>) -> Result<Mat<f64>, LltError> {
+    let n = a.nrows();
+    let mut l = Mat::from_fn(n, n, |i, j| if i >= j { a[(i, j)] } else { 0.0 });
+    let par = Par::Seq;
+    let mut mem = MemBuffer::new(cholesky_in_place_scratch::<f64>(n, par, Default::default()));
+    cholesky_in_place(
+        l.as_mut(),
+        Default::default(),
+        par,
+        MemStack::new(&mut mem),
+        Default::default(),
+    )?;
+    for j in 0..n {
+        for i in 0..j {
+            l[(i, j)] = 0.0;
+        }
+    }
+    Ok(l)
+}
