@@ -22,7 +22,7 @@
  * (fricont_problem_new_solve, blocks of at most 16 columns): every check applies.
  *
  * usage: cholmod_ref DIR [--base 0|1] [--storage full|lower|upper] [--F value] [--r value]
- *                        [--events FILE] [--via ann|condensed|solve]
+ *                        [--events FILE] [--via ann|condensed|solve] [--threads N]
  */
 #include <math.h>
 #include <stdlib.h>
@@ -407,6 +407,7 @@ int main(int argc, char **argv) {
     int64_t base = 0;
     int32_t storage = FRICONT_STORAGE_FULL;
     double F = -1, r = -1;
+    int64_t threads = 0;
     for (int i = 2; i + 1 < argc; i += 2) {
         if (!strcmp(argv[i], "--base")) base = atoi(argv[i + 1]);
         else if (!strcmp(argv[i], "--storage"))
@@ -417,6 +418,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(argv[i], "--r")) r = atof(argv[i + 1]);
         else if (!strcmp(argv[i], "--events")) events_file = argv[i + 1];
         else if (!strcmp(argv[i], "--via")) via = argv[i + 1];
+        else if (!strcmp(argv[i], "--threads")) threads = atoi(argv[i + 1]);
     }
     ref_t R;
     memset(&R, 0, sizeof R);
@@ -448,6 +450,7 @@ int main(int argc, char **argv) {
     }
     CHECK(st == FRICONT_OK, "problem (via %s): %s", via, fricont_status_str(st));
     if (r > 0) CHECK(fricont_problem_set_r(prob, r) == FRICONT_OK, "set_r");
+    if (threads > 0) CHECK(fricont_problem_set_threads(prob, threads) == FRICONT_OK, "set_threads");
     double r0 = 0;
     CHECK(fricont_problem_r(prob, &R.r, &r0) == FRICONT_OK, "problem_r");
     /* (condensed input equilibrates W by its own diagonal, so its default r differs) */

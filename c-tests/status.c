@@ -184,6 +184,11 @@ static void test_problem_setters(void) {
     EXPECT(fricont_problem_set_r(p, 0.0), FRICONT_ERR_RANGE, "r = 0");
     EXPECT(fricont_problem_set_r(p, -1.0), FRICONT_ERR_RANGE, "r = -1");
     EXPECT(fricont_problem_set_r(p, INFINITY), FRICONT_ERR_RANGE, "r = inf");
+    EXPECT(fricont_problem_set_threads(NULL, 2), FRICONT_ERR_NULL, "problem");
+    EXPECT(fricont_problem_set_threads(p, 0), FRICONT_ERR_RANGE, "threads = 0");
+    EXPECT(fricont_problem_set_threads(p, -3), FRICONT_ERR_RANGE, "threads = -3");
+    EXPECT(fricont_problem_set_threads(p, 1025), FRICONT_ERR_RANGE, "threads = 1025");
+    EXPECT(fricont_problem_set_threads(p, 1), FRICONT_OK, "");
     double g2[] = {0.0, 0.0}, gnan[] = {NAN};
     EXPECT(fricont_problem_set_gap(p, g2, 2), FRICONT_ERR_LENGTH, "gap has 2 values");
     EXPECT(fricont_problem_set_gap(p, gnan, 1), FRICONT_ERR_NONFINITE, "gap[0]");

@@ -354,6 +354,13 @@ int main(int argc, char **argv) {
             status = e.status();
         }
         report("negative friction throws FRICONT_ERR_RANGE", status == FRICONT_ERR_RANGE);
+        status = 0;
+        try {
+            prob.set_threads(0);
+        } catch (const fricont::Error &e) {
+            status = e.status();
+        }
+        report("0 threads throws FRICONT_ERR_RANGE", status == FRICONT_ERR_RANGE);
     }
 
     // 8. The hosts' constructors: N, T and a solve (a banded Cholesky written here), and

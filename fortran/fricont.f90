@@ -131,6 +131,7 @@ module fricont
         generic :: set_friction => problem_set_friction_scalar, problem_set_friction_nodes
         procedure :: set_gap => problem_set_gap
         procedure :: set_r => problem_set_r
+        procedure :: set_threads => problem_set_threads
         procedure :: build => problem_build
         procedure :: n => problem_n
         procedure :: p => problem_p
@@ -284,6 +285,12 @@ module fricont
             type(c_ptr), value :: h
             real(c_double), value :: r
             integer(c_int32_t) :: c_problem_set_r
+        end function
+        function c_problem_set_threads(h, threads) bind(C, name="fricont_problem_set_threads")
+            import :: c_ptr, c_int64_t, c_int32_t
+            type(c_ptr), value :: h
+            integer(c_int64_t), value :: threads
+            integer(c_int32_t) :: c_problem_set_threads
         end function
         function c_problem_new_condensed(p, w, ldw, out) &
             bind(C, name="fricont_problem_new_condensed")
@@ -773,6 +780,17 @@ contains
         type(fricont_error), intent(out), optional :: err
         call handle(c_problem_set_r(self%h, r), err, 'fricont_problem%set_r')
     end subroutine problem_set_r
+
+    !> Threads of the set-up (factorisation of A and forming W), 1..1024; default 1 (no
+    !> thread is started). Results agree with one thread to rounding; tracing runs on the
+    !> calling thread. FRICONT_ERR_RANGE outside 1..1024.
+    subroutine problem_set_threads(self, threads, err)
+        class(fricont_problem), intent(inout) :: self
+        integer, intent(in) :: threads
+        type(fricont_error), intent(out), optional :: err
+        call handle(c_problem_set_threads(self%h, int(threads, c_int64_t)), err, &
+                    'fricont_problem%set_threads')
+    end subroutine problem_set_threads
 
     !> Validates and factorises now (optional: paths build when needed).
     subroutine problem_build(self, err)

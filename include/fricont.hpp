@@ -301,6 +301,9 @@ public:
     }
     /// The augmentation parameter r > 0 (does not change solutions).
     void set_r(double r) { check(fricont_problem_set_r(h_, r)); }
+    /// Threads of the set-up (factorisation of A, forming W), 1..=1024; default 1 (no
+    /// thread started). Results agree with one thread to rounding. Throws on a bad count.
+    void set_threads(int64_t threads) { check(fricont_problem_set_threads(h_, threads)); }
     /// Validates and factorises now (optional).
     void build() { check(fricont_problem_build(h_)); }
     /// Number of dofs n.

@@ -93,3 +93,28 @@ fn wide_rows_fall_back_to_solves_and_match_a_dense_reference() {
     }
     assert!(dmax <= 1e-13, "relative difference {dmax:e}");
 }
+
+/// The set-up on a private pool of 2 or 3 threads gives W and the events of the
+/// single-threaded set-up to rounding (1e-14 relative), on a mesh whose supernodes are
+/// large enough for faer's parallel kernels; 0 threads is refused.
+#[test]
+fn threads_give_the_same_w_and_events() {
+    let case = common::fe_case(11, 120, 10, 1.0);
+    let data = &case.data;
+    let build = |threads: usize| data.builder().threads(threads).build();
+    let one = std::sync::Arc::new(build(1).unwrap());
+    let reference = common::trace(one.clone(), data.affine_load(), case.a0, case.a1);
+    assert!(reference.events().len() > 5);
+    for threads in [2, 3] {
+        let many = std::sync::Arc::new(build(threads).unwrap());
+        let d = max_rel_diff(one.delassus().w(), many.delassus().w());
+        assert!(d <= 1e-14, "{threads} threads: W differs by {d:e}");
+        let path = common::trace(many, data.affine_load(), case.a0, case.a1);
+        assert_eq!(path.events().len(), reference.events().len());
+        for (x, y) in path.events().iter().zip(reference.events()) {
+            assert!((x.alpha - y.alpha).abs() <= 1e-12 * x.alpha.abs().max(1.0));
+            assert_eq!((x.node, x.from, x.to), (y.node, y.from, y.to));
+        }
+    }
+    assert!(matches!(build(0), Err(fricont::Error::InvalidParameter(_))));
+}

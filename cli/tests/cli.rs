@@ -643,6 +643,8 @@ fn bad_options_exit_2() {
     for args in [
         vec!["trace", dir, "--r", "-1"],
         vec!["trace", dir, "--r", "abc"],
+        vec!["trace", dir, "--threads", "0"],
+        vec!["trace", dir, "--threads", "4096"],
         vec!["trace", dir, "--alpha-start", "2", "--alpha-end", "2"],
         vec!["trace"],
         vec!["frobnicate"],
@@ -698,6 +700,17 @@ fn sample_runs_through_the_cli() {
         assert_eq!(e.node as u64 + 1, j["node"].as_u64().unwrap());
         assert_eq!(e.from.name(), j["from"].as_str().unwrap());
         assert_eq!(e.to.name(), j["to"].as_str().unwrap());
+    }
+    // The set-up on 2 threads: the same transitions, α to rounding.
+    let (t2, _) = trace_json(&sample_dir(), &["--threads", "2"]);
+    let (a, b) = (event_list(&v), event_list(&t2));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            (x.0 - y.0).abs() <= 1e-12 * x.0.abs().max(1.0),
+            "{x:?} {y:?}"
+        );
+        assert_eq!((x.1, &x.2, &x.3), (y.1, &y.2, &y.3));
     }
     // Every event has a table row with its 1-based node and its α to 14 digits.
     for e in events {

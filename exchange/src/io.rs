@@ -162,6 +162,16 @@ impl CaseData {
     /// Cholesky of A and the Delassus operator W. Errors: those of
     /// [`ProblemBuilder::build`] (A not SPD, B rank-deficient, F < 0, r ≤ 0, …).
     pub fn problem(&self, r: Option<f64>) -> Result<Problem> {
+        let mut b = self.builder();
+        if let Some(r) = r {
+            b = b.r(r);
+        }
+        Ok(b.build()?)
+    }
+
+    /// The builder of [`CaseData::problem`] before `build`, for settings the files do not
+    /// hold (r, threads). Copies A, N, T (the case keeps its own).
+    pub fn builder(&self) -> ProblemBuilder {
         let mut b = ProblemBuilder::new(
             self.a.clone(),
             Storage::Full,
@@ -176,10 +186,7 @@ impl CaseData {
         if let Some(g) = &self.gap {
             b = b.gap(g.clone());
         }
-        if let Some(r) = r {
-            b = b.r(r);
-        }
-        Ok(b.build()?)
+        b
     }
 
     /// The affine load `f(α) = f0 + α f1` of the files. Errors: lengths differ, non-finite

@@ -275,6 +275,10 @@ contains
                    err%status == FRICONT_ERR_LENGTH, err%message)
         call prob%set_friction(-1.0_real64, err=err)
         call check('negative friction: FRICONT_ERR_RANGE', err%status == FRICONT_ERR_RANGE)
+        call prob%set_threads(0, err=err)
+        call check('0 threads: FRICONT_ERR_RANGE', err%status == FRICONT_ERR_RANGE, err%message)
+        call prob%set_threads(2, err=err)
+        call check('2 threads accepted', err%status == FRICONT_OK, err%message)
         call check('status name', &
                    index(fricont_status_name(FRICONT_ERR_CSR), 'FRICONT_ERR_CSR') == 1)
     end subroutine run_all
