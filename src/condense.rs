@@ -182,7 +182,9 @@ pub struct Delassus {
     op: Operator,
     b: CsrMatrix,
     w: Mat<f64>,
-    trailing: bool,
+    /// `Z = L_SS⁻¹ B_Sᵀ` (s × 2p, rows in the factor's order) when W came from the trailing
+    /// block: it also turns a back-solve for u into a half solve ([`Self::displacements`]).
+    z: Option<Mat<f64>>,
     times: SetupTimes,
 }
 
@@ -288,7 +290,7 @@ impl Delassus {
             op: Operator::Cholesky { symbolic, l_values },
             b: b.clone(),
             w: Mat::zeros(0, 0),
-            trailing: false,
+            z: None,
             times: SetupTimes::default(),
         };
         this.times.analyse_s = analyse_s;
@@ -303,8 +305,8 @@ impl Delassus {
             .transpose()?
             .flatten()
         {
-            Some(w) => {
-                this.trailing = true;
+            Some((w, z)) => {
+                this.z = Some(z);
                 w
             }
             None => this.w_by_solves()?,
@@ -317,7 +319,7 @@ impl Delassus {
     /// `W = Zᵀ Z`, `Z = L_SS⁻¹ B_Sᵀ`, from the trailing s × s block of a supernodal factor
     /// whose ordering puts the s dofs that B touches last. None when the factor does not
     /// have that form (then W is formed by solves).
-    fn w_by_trailing_block(&self, s: usize, par: Par) -> Result<Option<Mat<f64>>> {
+    fn w_by_trailing_block(&self, s: usize, par: Par) -> Result<Option<(Mat<f64>, Mat<f64>)>> {
         let n = self.n;
         let m = self.b.nrows();
         let Operator::Cholesky { symbolic, l_values } = &self.op else {
@@ -377,7 +379,7 @@ impl Delassus {
             par,
         );
         symmetrise(&mut w);
-        Ok(Some(w))
+        Ok(Some((w, z)))
     }
 
     /// `W = B A⁻¹ Bᵀ` by 2p solves with the factor of A, in blocks of columns: how W is
@@ -475,7 +477,105 @@ impl Delassus {
     /// True when W was formed from the trailing block of the factor (the dofs that B
     /// touches ordered last), false when by 2p solves (wide rows of B).
     pub fn w_from_trailing_block(&self) -> bool {
-        self.trailing
+        self.z.is_some()
+    }
+
+    /// True when [`Self::half_solve`] and [`Self::displacements`] are available (fricont's
+    /// own factor, W from its trailing block).
+    pub(crate) fn has_half_solve(&self) -> bool {
+        self.z.is_some()
+    }
+
+    /// The forward half of a solve with A: `Y = L⁻¹ Pᵀ X` in place for every column of `x`
+    /// (n rows), in the factor's order. Errors: [`Error::Usage`] without
+    /// [`Self::has_half_solve`].
+    pub(crate) fn half_solve(&self, mut x: MatMut<'_, f64>) -> Result<()> {
+        let (llt, fwd) = self.supernodal()?;
+        let k = x.ncols();
+        let mut col = vec![0.0; self.n];
+        for c in 0..k {
+            for (i, &j) in fwd.iter().enumerate() {
+                col[i] = x[(j, c)];
+            }
+            for (i, v) in col.iter().enumerate() {
+                x[(i, c)] = *v;
+            }
+        }
+        let mut mem = self.solve_scratch(k)?;
+        llt.l_solve_with_conj(Conj::No, x, Par::Seq, MemStack::new(&mut mem));
+        Ok(())
+    }
+
+    /// `q = B A⁻¹ v` from `y = L⁻¹ Pᵀ v` ([`Self::half_solve`]): `q = Zᵀ y_S`, because
+    /// the last s entries of `L⁻ᵀ y` depend on the last s entries of `y` only.
+    pub(crate) fn condense_half(&self, y: &[f64]) -> Vec<f64> {
+        let z = self
+            .z
+            .as_ref()
+            .expect("condense_half needs the trailing block");
+        let first = self.n - z.nrows();
+        (0..z.ncols())
+            .map(|i| (0..z.nrows()).map(|r| z[(r, i)] * y[first + r]).sum())
+            .collect()
+    }
+
+    /// `u = A⁻¹ (f + Bᵀ λ)` for every column, from the half-solved loads `y = L⁻¹ Pᵀ f`
+    /// (n × k, overwritten) and the contact forces `lam` (2p × k, equilibrated rows):
+    /// `L⁻¹ Pᵀ Bᵀ λ = (0, Z λ)`, so only the backward half `P L⁻ᵀ (y + (0, Z λ))` touches
+    /// the whole factor. Errors: [`Error::Usage`] without [`Self::has_half_solve`]; out of
+    /// memory.
+    pub(crate) fn displacements(
+        &self,
+        mut y: MatMut<'_, f64>,
+        lam: MatRef<'_, f64>,
+    ) -> Result<Mat<f64>> {
+        let (llt, fwd) = self.supernodal()?;
+        let z = self.z.as_ref().expect("supernodal() checked z");
+        let (n, k) = (self.n, y.ncols());
+        let first = n - z.nrows();
+        faer::linalg::matmul::matmul(
+            y.as_mut().subrows_mut(first, z.nrows()),
+            Accum::Add,
+            z.as_ref(),
+            lam,
+            1.0,
+            Par::Seq,
+        );
+        let mut mem = self.solve_scratch(k)?;
+        llt.l_transpose_solve_with_conj(Conj::No, y.as_mut(), Par::Seq, MemStack::new(&mut mem));
+        let mut u = try_zeros(n, k, "the displacements u")?;
+        for c in 0..k {
+            for (i, &j) in fwd.iter().enumerate() {
+                u[(j, c)] = y[(i, c)];
+            }
+        }
+        Ok(u)
+    }
+
+    fn supernodal(&self) -> Result<(SupernodalLltRef<'_, usize, f64>, &[usize])> {
+        if let (Operator::Cholesky { symbolic, l_values }, Some(_)) = (&self.op, &self.z)
+            && let SymbolicCholeskyRaw::Supernodal(sym) = symbolic.raw()
+            && let Some(perm) = symbolic.perm()
+        {
+            return Ok((
+                SupernodalLltRef::<'_, usize, f64>::new(sym, l_values),
+                perm.arrays().0,
+            ));
+        }
+        Err(Error::Usage(
+            "half solves need fricont's own factor with W from its trailing block".into(),
+        ))
+    }
+
+    fn solve_scratch(&self, k: usize) -> Result<MemBuffer> {
+        let Operator::Cholesky { symbolic, .. } = &self.op else {
+            unreachable!("checked by supernodal()")
+        };
+        MemBuffer::try_new(symbolic.solve_in_place_scratch::<f64>(k, Par::Seq)).map_err(|_| {
+            Error::OutOfMemory(format!(
+                "the workspace of a solve with {k} right-hand sides"
+            ))
+        })
     }
 
     /// `B = [N; T]`.
@@ -572,7 +672,7 @@ impl Delassus {
             op: Operator::Host(solve),
             b: b.clone(),
             w: Mat::zeros(0, 0),
-            trailing: false,
+            z: None,
             times: SetupTimes::default(),
         };
         let m = b.nrows();
@@ -612,7 +712,7 @@ impl Delassus {
             op: Operator::Condensed { row_scale },
             b: CsrMatrix::from_triplets("B", w.nrows(), 0, &[]).expect("an empty matrix"),
             w,
-            trailing: false,
+            z: None,
             times: SetupTimes::default(),
         }
     }

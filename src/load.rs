@@ -154,6 +154,9 @@ pub(crate) struct BoundLoad {
     load: Load,
     /// Affine: `[q0, q1]`; basis: `q_j`; general: empty.
     q_basis: Vec<Vec<f64>>,
+    /// The same vectors half-solved, `L⁻¹ Pᵀ f_j` (n × k), when the problem has half
+    /// solves ([`Delassus::displacements`]): u at an event then costs a backward half only.
+    half: Option<faer::Mat<f64>>,
     weights: Vec<f64>,
     dweights: Vec<f64>,
     /// α of `weights` (NaN before the first evaluation).
@@ -183,13 +186,32 @@ impl BoundLoad {
         } else {
             0
         };
-        let q_basis = vectors
-            .into_iter()
-            .map(|v| del.condense(v))
-            .collect::<Result<_>>()?;
+        let (q_basis, half) = if del.has_half_solve() && !vectors.is_empty() {
+            let n = del.n();
+            let mut y = crate::error::try_zeros(n, vectors.len(), "the half-solved load vectors")?;
+            for (c, v) in vectors.iter().enumerate() {
+                for (i, x) in v.iter().enumerate() {
+                    y[(i, c)] = *x;
+                }
+            }
+            del.half_solve(y.as_mut())?;
+            let q = (0..y.ncols())
+                .map(|c| {
+                    del.condense_half(y.col(c).try_as_col_major().expect("contiguous").as_slice())
+                })
+                .collect();
+            (q, Some(y))
+        } else {
+            let q = vectors
+                .into_iter()
+                .map(|v| del.condense(v))
+                .collect::<Result<_>>()?;
+            (q, None)
+        };
         Ok(Self {
             load,
             q_basis,
+            half,
             weights: vec![0.0; k],
             dweights: vec![0.0; k],
             weights_alpha: f64::NAN,
@@ -285,6 +307,30 @@ impl BoundLoad {
             (_, LoadSnapshot::Force(f)) => f.clone(),
             (_, _) => unreachable!("a snapshot always matches its load"),
         }
+    }
+
+    /// True when [`Self::half_solved_from`] answers (an affine or basis load on a problem
+    /// with half solves).
+    pub(crate) fn has_half(&self) -> bool {
+        self.half.is_some()
+    }
+
+    /// `L⁻¹ Pᵀ f(α)` for an affine or basis load whose vectors were half-solved (see
+    /// [`Delassus::half_solve`]); `None` otherwise (a general load: half-solve `f` itself).
+    pub(crate) fn half_solved_from(&self, alpha: f64, snap: &LoadSnapshot) -> Option<Vec<f64>> {
+        let y = self.half.as_ref()?;
+        let w: Vec<f64> = match (&self.load, snap) {
+            (Load::Affine { .. }, _) => vec![1.0, alpha],
+            (Load::Basis { .. }, LoadSnapshot::Weights(w)) => w.clone(),
+            _ => return None,
+        };
+        let mut out = vec![0.0; y.nrows()];
+        for (c, wc) in w.iter().enumerate() {
+            for (o, v) in out.iter_mut().zip(y.col(c).iter()) {
+                *o += wc * v;
+            }
+        }
+        Some(out)
     }
 
     /// The load vector `f(α)` (n entries).

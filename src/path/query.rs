@@ -27,22 +27,22 @@ impl Path {
             .unwrap_or(&[])
     }
 
-    /// The full state at event `k`: u by one back-solve of `f(α) + Bᵀλ`, and the residual.
+    /// The full state at event `k`: u = A⁻¹ (f(α) + Bᵀλ) (with fricont's own factor and an
+    /// affine or basis load, by the backward half of a solve only: see
+    /// [`Path::event_states`]), and the residual.
     /// Never calls the load's closures: the load at the event was kept when it was found
     /// (nothing for an affine load, the weights for a basis load, f(α) for a general one).
     /// Errors: not started, `k` out of range.
     pub fn event_state(&self, k: usize) -> Result<State> {
         let tr = self.trace_ref()?;
-        let e = tr.events.get(k).ok_or_else(|| {
-            Error::Usage(format!(
+        if k >= tr.events.len() {
+            return Err(Error::Usage(format!(
                 "event {k} does not exist ({} events)",
                 tr.events.len()
-            ))
-        })?;
-        let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
-        let lam = self.lam_to_internal(&lam);
-        let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
-        self.state_with_force(&lam, e.alpha, &e.classes, f)
+            )));
+        }
+        let mut s = self.event_states(k..k + 1)?;
+        Ok(s.remove(0))
     }
 
     /// The full states of events `range` (as [`Path::event_state`]), with the back-solves
@@ -72,30 +72,64 @@ impl Path {
             }
         }
         let mut by_transition: Vec<State> = Vec::with_capacity(firsts.len());
+        let del = self.problem.delassus();
+        let m = 2 * self.problem.p();
         for block in firsts.chunks(32) {
-            let mut x = faer::Mat::<f64>::zeros(n, block.len());
+            let mut x = crate::error::try_zeros(
+                if has_solve { n } else { 0 },
+                block.len(),
+                "the right-hand sides of the back-solves for u",
+            )?;
+            let mut lams = faer::Mat::<f64>::zeros(m, block.len());
             let mut inputs = Vec::with_capacity(block.len());
+            // With half solves, only the backward half of each solve is done per event:
+            // the load's half is kept per load vector (affine and basis loads).
+            let cached = del.has_half_solve() && self.load.has_half();
             for (c, &k) in block.iter().enumerate() {
                 let e = &tr.events[k];
                 let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
                 let lam = self.lam_to_internal(&lam);
                 let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
                 if has_solve {
-                    let mut rhs = f.clone();
-                    self.problem.b().mul_t_vec_add(&lam, &mut rhs);
-                    for (i, v) in rhs.into_iter().enumerate() {
+                    for (i, &l) in lam.iter().enumerate() {
+                        lams[(i, c)] = l;
+                    }
+                    let col = match cached {
+                        true => self
+                            .load
+                            .half_solved_from(e.alpha, &tr.event_loads[k])
+                            .expect("a snapshot always matches its load"),
+                        false => f.clone(),
+                    };
+                    for (i, v) in col.into_iter().enumerate() {
                         x[(i, c)] = v;
                     }
                 }
                 inputs.push((k, lam, f));
             }
-            if has_solve {
-                self.problem.delassus().solve_mat_in_place(x.as_mut())?;
-            }
+            let u = if !has_solve {
+                x
+            } else if del.has_half_solve() {
+                if !cached {
+                    // A general load: the loads' half here (the columns hold f).
+                    del.half_solve(x.as_mut())?;
+                }
+                del.displacements(x.as_mut(), lams.as_ref())?
+            } else {
+                for (c, (_, lam, _)) in inputs.iter().enumerate() {
+                    let mut bt = vec![0.0; n];
+                    self.problem.b().mul_t_vec_add(lam, &mut bt);
+                    for (i, v) in bt.into_iter().enumerate() {
+                        x[(i, c)] += v;
+                    }
+                }
+                del.solve_mat_in_place(x.as_mut())?;
+                x
+            };
             for (c, (k, lam, f)) in inputs.into_iter().enumerate() {
                 let e = &tr.events[k];
-                let u: Vec<f64> = (0..n).map(|i| x[(i, c)]).collect();
-                by_transition.push(self.state_from_u(&lam, e.alpha, &e.classes, &f, u));
+                let uc: Vec<f64> = (0..u.nrows()).map(|i| u[(i, c)]).collect();
+                by_transition.push(self.state_from_u(&lam, e.alpha, &e.classes, &f, uc));
             }
         }
         let mut out = Vec::with_capacity(range.len());
