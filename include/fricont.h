@@ -119,7 +119,8 @@ enum fricont_status
     /**
      * Usage: a call made in the wrong order (querying or stepping a path that was not
      * started, setting path options after the start, choosing a branch where there is no
-     * bifurcation, starting without an α window).
+     * bifurcation, starting without an α window), or a call into a path from inside one
+     * of its own load callbacks (which would re-enter a step under way).
      */
     FRICONT_ERR_ORDER = -104,
     /**
@@ -302,6 +303,11 @@ enum fricont_end_reason
      * message of the failing call says what happened.
      */
     FRICONT_END_FAILED = 5,
+    /**
+     * The monitor (`fricont_path_set_monitor`) asked to stop. Not final:
+     * `fricont_path_step` and `fricont_path_run` continue from where the path stopped.
+     */
+    FRICONT_END_STOPPED = 6,
 };
 #ifndef __cplusplus
 #if __STDC_VERSION__ >= 202311L
@@ -430,13 +436,36 @@ typedef int32_t (*fricont_weights_fn)(double alpha,
  * `f_out` is treated the same way (`FRICONT_ERR_CALLBACK_VALUE`). Callbacks are called
  * synchronously, on the thread that called into the library, possibly several times per
  * step and at α slightly outside the window (finite differences). They must not throw
- * (C++), `longjmp`, call `mexErrMsgTxt`, or call back into the same path handle: return
- * a code instead.
+ * (C++), `longjmp` or call `mexErrMsgTxt`: return a code instead. A call into the same
+ * path handle from inside the callback returns `FRICONT_ERR_ORDER` and changes nothing.
  */
 typedef int32_t (*fricont_load_fn)(double alpha,
                                    double *f_out,
                                    int64_t n,
                                    void *user_data);
+
+/**
+ * A progress monitor, called by `fricont_path_run` after each transition point.
+ *
+ * * `alpha`: α of the transition point just passed.
+ * * `transitions`: transition points traced so far (events of one degenerate transition
+ *   count once).
+ * * `first_event`, `end_event`: the new events are `first_event .. end_event − 1`
+ *   (0-based, for `fricont_path_event`; one per node that changed class).
+ * * `user_data`: the pointer given to `fricont_path_set_monitor`.
+ *
+ * Return 0 to go on; any other value stops the path cleanly: `fricont_path_run` returns
+ * `FRICONT_END` with the end reason `FRICONT_END_STOPPED`, everything traced is kept, and
+ * `fricont_path_step` / `fricont_path_run` continue from there. Called synchronously on
+ * the thread that called `fricont_path_run`, with the path handle free: the monitor may
+ * call the path's queries (`fricont_path_event`, `fricont_path_event_state`, …) but must
+ * not free the path. It must not throw (C++), `longjmp` or call `mexErrMsgTxt`.
+ */
+typedef int32_t (*fricont_monitor_fn)(double alpha,
+                                      int64_t transitions,
+                                      int64_t first_event,
+                                      int64_t end_event,
+                                      void *user_data);
 
 /**
  * One node changing class at a transition point (a plain value, copied out by
@@ -1060,6 +1089,50 @@ fricont_status fricont_path_set_zero_tol(struct fricont_path *path,
                                          double zero_tol);
 
 /**
+ * Sets the largest α step of the step control of a nonlinear load (a path made by
+ * `fricont_path_new_basis` or `fricont_path_new_general`), in α units. Default: 1/8 of
+ * the window's length; must be finite and > 0. Only before the first start.
+ *
+ * Each step is also shortened until the cubic Hermite model of every guard predicts a
+ * fresh evaluation at the step's midpoint. A load that varies faster than that test can
+ * see (a guard that dips below zero and comes back within a stretch narrower than the
+ * step at which the test passes) is caught only by a step no longer than that stretch:
+ * for an oscillating load, set this to a fraction of its shortest period. No effect on an
+ * affine load, whose pieces are followed exactly.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (not finite or ≤ 0),
+ * `FRICONT_ERR_ORDER` (after the first start), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `path` is NULL or a live handle.
+ */
+fricont_status fricont_path_set_max_alpha_step(struct fricont_path *path,
+                                               double max_alpha_step);
+
+/**
+ * Sets (or, with `monitor` = NULL, removes) the progress monitor that
+ * `fricont_path_run` calls after each transition point (see `fricont_monitor_fn`). May be
+ * called at any time, also from inside the monitor (the new one takes effect at the next
+ * transition point).
+ *
+ * * `user_data`: handed to every call of `monitor`; never dereferenced by the library.
+ * * `free_user_data`: NULL, or called exactly once with `user_data` when the monitor is
+ *   replaced or removed, or the path is freed; also when this call fails with
+ *   `FRICONT_ERR_POISONED` or `FRICONT_ERR_PANIC`, so that ownership always passes.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_ORDER` (called from a
+ * load callback of the same path), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `path` is NULL or a live handle; `monitor` and `free_user_data` are NULL or valid
+ * functions of their types.
+ */
+fricont_status fricont_path_set_monitor(struct fricont_path *path,
+                                        fricont_monitor_fn monitor,
+                                        void *user_data,
+                                        fricont_free_fn free_user_data);
+
+/**
  * Starts (or restarts) the path at `alpha` with the fixed-α solver (semi-smooth Newton
  * with a line search, then projected block Gauss–Seidel if that stalls), from the contact forces `guess` = (λν, λt) or, if `guess` is
  * NULL, from zero forces. A restart clears the events and pieces traced so far. The load
@@ -1102,8 +1175,10 @@ fricont_status fricont_path_start(struct fricont_path *path,
 fricont_status fricont_path_step(struct fricont_path *path);
 
 /**
- * Steps until the path ends. Returns `FRICONT_END` (see `fricont_path_end_reason`) or the
- * first error of `fricont_path_step`.
+ * Steps until the path ends, calling the monitor (`fricont_path_set_monitor`), if any,
+ * after each transition point. Returns `FRICONT_END` (see `fricont_path_end_reason`:
+ * `FRICONT_END_STOPPED` when the monitor stopped it) or the first error of
+ * `fricont_path_step`.
  *
  * # Safety
  * `path` is NULL or a live handle.

@@ -63,5 +63,5 @@ pub use error::{Error, Result};
 /// blocks of a [`HostSolve`] are faer matrices).
 pub use faer;
 pub use load::Load;
-pub use path::{EndReason, Event, Path, PathOptions, PieceRecord, Solution, StepOutcome};
+pub use path::{EndReason, Event, Path, PathOptions, PieceRecord, Progress, Solution, StepOutcome};
 pub use problem::{CsrMatrix, Problem, ProblemBuilder, Storage};

@@ -159,3 +159,68 @@ fn finite_element_sine_shear_finds_every_transition() {
     }
     assert!(checked >= 4, "only {checked} fold-free cases");
 }
+
+/// One node as above under the normal load `c(α) = 0.5 − 0.6 exp(−((α − α_b)/w)²)`: a
+/// bump of width w = 2e-3 at α_b = 21.5/64 (half-way between two points of the dyadic
+/// grid of 1/64 on which the default step control evaluates here) opens the node for a stretch of α of width
+/// 2 w √ln 6 ≈ 5.4e-3 around α_b (transitions where the exponential equals 5/6). The
+/// step control of the default (steps up to 1/8 of the window, each checked at its
+/// midpoint) evaluates the load nowhere near the bump, sees a flat load and misses it:
+/// the documented limit. `max_alpha_step` = 1e-3 (below the stretch) finds both
+/// transitions, at the analytic α to 1e-10.
+#[test]
+fn a_narrow_bump_needs_max_alpha_step_and_is_found_with_it() {
+    let (ab, w) = (21.5f64 / 64.0, 2e-3f64);
+    let half = w * (6.0f64 / 5.0).ln().sqrt();
+    let want = [
+        (ab - half, Class::Stick, Class::Open),
+        (ab + half, Class::Open, Class::Stick),
+    ];
+    let trace = |max_step: Option<f64>| {
+        let a = CsrMatrix::from_dense(2, 2, &[1.0, 0.0, 0.0, 1.0]).unwrap();
+        let n = CsrMatrix::from_dense(1, 2, &[1.0, 0.0]).unwrap();
+        let t = CsrMatrix::from_dense(1, 2, &[0.0, 1.0]).unwrap();
+        let problem = Arc::new(
+            ProblemBuilder::new(a, Storage::Full, n, t)
+                .friction_uniform(0.3)
+                .build()
+                .unwrap(),
+        );
+        let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+            out[0] = 0.5 - 0.6 * (-((al - ab) / w).powi(2)).exp();
+            out[1] = 0.0;
+            Ok(())
+        });
+        let mut opts = PathOptions::window(-1.0, 1.0);
+        opts.max_alpha_step = max_step;
+        let mut path = Path::new(problem, Load::general(2, f, None), opts).unwrap();
+        path.start(-1.0, None).unwrap();
+        assert_eq!(path.run().unwrap(), EndReason::Window);
+        path.events()
+            .iter()
+            .map(|e| (e.alpha, e.from, e.to))
+            .collect::<Vec<_>>()
+    };
+    let coarse = trace(None);
+    assert!(
+        coarse.is_empty(),
+        "the default steps were expected to step over the bump (the documented limit), got {coarse:?}; \
+         if the step control now sees it, update this test and the docs"
+    );
+    let fine = trace(Some(1e-3));
+    assert_eq!(fine.len(), 2, "events {fine:?}");
+    for (g, w) in fine.iter().zip(&want) {
+        assert!((g.0 - w.0).abs() <= 1e-10, "α {} expected {}", g.0, w.0);
+        assert_eq!((g.1, g.2), (w.1, w.2));
+    }
+    // invalid values are refused when the path is made
+    for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+        let mut opts = PathOptions::window(-1.0, 1.0);
+        opts.max_alpha_step = Some(bad);
+        let data = common::one_node(0.3, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]);
+        assert!(
+            Path::new(Arc::new(data.problem()), data.affine_load(), opts).is_err(),
+            "max_alpha_step {bad} accepted"
+        );
+    }
+}

@@ -29,8 +29,8 @@ use crate::problem::Problem;
 /// `f_out` is treated the same way (`FRICONT_ERR_CALLBACK_VALUE`). Callbacks are called
 /// synchronously, on the thread that called into the library, possibly several times per
 /// step and at α slightly outside the window (finite differences). They must not throw
-/// (C++), `longjmp`, call `mexErrMsgTxt`, or call back into the same path handle: return
-/// a code instead.
+/// (C++), `longjmp` or call `mexErrMsgTxt`: return a code instead. A call into the same
+/// path handle from inside the callback returns `FRICONT_ERR_ORDER` and changes nothing.
 #[allow(non_camel_case_types)]
 pub type fricont_load_fn = Option<
     unsafe extern "C" fn(alpha: f64, f_out: *mut f64, n: i64, user_data: *mut c_void) -> i32,
@@ -47,6 +47,32 @@ pub type fricont_weights_fn = Option<
         phi: *mut f64,
         dphi: *mut f64,
         k: i64,
+        user_data: *mut c_void,
+    ) -> i32,
+>;
+
+/// A progress monitor, called by `fricont_path_run` after each transition point.
+///
+/// * `alpha`: α of the transition point just passed.
+/// * `transitions`: transition points traced so far (events of one degenerate transition
+///   count once).
+/// * `first_event`, `end_event`: the new events are `first_event .. end_event − 1`
+///   (0-based, for `fricont_path_event`; one per node that changed class).
+/// * `user_data`: the pointer given to `fricont_path_set_monitor`.
+///
+/// Return 0 to go on; any other value stops the path cleanly: `fricont_path_run` returns
+/// `FRICONT_END` with the end reason `FRICONT_END_STOPPED`, everything traced is kept, and
+/// `fricont_path_step` / `fricont_path_run` continue from there. Called synchronously on
+/// the thread that called `fricont_path_run`, with the path handle free: the monitor may
+/// call the path's queries (`fricont_path_event`, `fricont_path_event_state`, …) but must
+/// not free the path. It must not throw (C++), `longjmp` or call `mexErrMsgTxt`.
+#[allow(non_camel_case_types)]
+pub type fricont_monitor_fn = Option<
+    unsafe extern "C" fn(
+        alpha: f64,
+        transitions: i64,
+        first_event: i64,
+        end_event: i64,
         user_data: *mut c_void,
     ) -> i32,
 >;
@@ -196,9 +222,33 @@ unsafe impl Sync for UserData {}
 pub struct fricont_path {
     slot: ErrorSlot,
     /// Only shared references to the handle are ever formed (the slot is read by the
-    /// boundary while the body runs); the mutable part sits in a `RefCell`. A callback that
-    /// re-enters the same handle hits the borrow check, a caught panic.
+    /// boundary while the body runs); the mutable part sits in a `RefCell`. A load
+    /// callback that re-enters the same handle finds it borrowed: `FRICONT_ERR_ORDER`.
     inner: RefCell<PathInner>,
+}
+
+/// The message of a call into a path from inside one of its own load callbacks.
+const BUSY: &str = "the path is busy: it was called from inside one of its own load callbacks (a callback must not call back into its path)";
+
+impl fricont_path {
+    /// The path's state for reading; `FRICONT_ERR_ORDER` while a step is under way (a
+    /// load callback calling back into its own path).
+    fn read(&self) -> FfiResult<std::cell::Ref<'_, PathInner>> {
+        self.inner.try_borrow().map_err(|_| Failure::order(BUSY))
+    }
+
+    /// The path's state for changing; `FRICONT_ERR_ORDER` as [`Self::read`].
+    fn lock(&self) -> FfiResult<std::cell::RefMut<'_, PathInner>> {
+        self.inner
+            .try_borrow_mut()
+            .map_err(|_| Failure::order(BUSY))
+    }
+}
+
+/// A monitor with its user data (finalised when dropped).
+struct Monitor {
+    f: unsafe extern "C" fn(f64, i64, i64, i64, *mut c_void) -> i32,
+    user: UserData,
 }
 
 struct PathInner {
@@ -210,6 +260,8 @@ struct PathInner {
     window: Option<(f64, f64)>,
     max_steps: usize,
     zero_tol: f64,
+    max_alpha_step: Option<f64>,
+    monitor: Option<Arc<Monitor>>,
     path: Option<Path>,
     solutions: Vec<Solution>,
 }
@@ -345,6 +397,8 @@ unsafe fn new_path(
             window: None,
             max_steps: 10_000,
             zero_tol: 1e-11,
+            max_alpha_step: None,
+            monitor: None,
             path: None,
             solutions: Vec::new(),
         }),
@@ -572,7 +626,7 @@ pub unsafe extern "C" fn fricont_path_set_window(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         h.configurable("the alpha window")?;
         if !alpha_start.is_finite() || !alpha_end.is_finite() || alpha_start == alpha_end {
             return Err(Failure::range(format!(
@@ -600,7 +654,7 @@ pub unsafe extern "C" fn fricont_path_set_max_steps(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         h.configurable("the step limit")?;
         if max_steps < 1 {
             return Err(Failure::range(format!("max_steps = {max_steps}, must be >= 1")));
@@ -627,12 +681,87 @@ pub unsafe extern "C" fn fricont_path_set_zero_tol(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         h.configurable("the zero tolerance")?;
         if !(zero_tol > 0.0 && zero_tol <= 1e-3) {
             return Err(Failure::range(format!("zero_tol = {zero_tol}, must be in (0, 1e-3]")));
         }
         h.zero_tol = zero_tol;
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Sets the largest α step of the step control of a nonlinear load (a path made by
+/// `fricont_path_new_basis` or `fricont_path_new_general`), in α units. Default: 1/8 of
+/// the window's length; must be finite and > 0. Only before the first start.
+///
+/// Each step is also shortened until the cubic Hermite model of every guard predicts a
+/// fresh evaluation at the step's midpoint. A load that varies faster than that test can
+/// see (a guard that dips below zero and comes back within a stretch narrower than the
+/// step at which the test passes) is caught only by a step no longer than that stretch:
+/// for an oscillating load, set this to a fraction of its shortest period. No effect on an
+/// affine load, whose pieces are followed exactly.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (not finite or ≤ 0),
+/// `FRICONT_ERR_ORDER` (after the first start), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_set_max_alpha_step(
+    path: *mut fricont_path,
+    max_alpha_step: f64,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let mut h = h.lock()?;
+        h.configurable("the largest alpha step")?;
+        if !(max_alpha_step.is_finite() && max_alpha_step > 0.0) {
+            return Err(Failure::range(format!(
+                "max_alpha_step = {max_alpha_step}, must be finite and > 0"
+            )));
+        }
+        h.max_alpha_step = Some(max_alpha_step);
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Sets (or, with `monitor` = NULL, removes) the progress monitor that
+/// `fricont_path_run` calls after each transition point (see `fricont_monitor_fn`). May be
+/// called at any time, also from inside the monitor (the new one takes effect at the next
+/// transition point).
+///
+/// * `user_data`: handed to every call of `monitor`; never dereferenced by the library.
+/// * `free_user_data`: NULL, or called exactly once with `user_data` when the monitor is
+///   replaced or removed, or the path is freed; also when this call fails with
+///   `FRICONT_ERR_POISONED` or `FRICONT_ERR_PANIC`, so that ownership always passes.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_ORDER` (called from a
+/// load callback of the same path), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `monitor` and `free_user_data` are NULL or valid
+/// functions of their types.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_set_monitor(
+    path: *mut fricont_path,
+    monitor: fricont_monitor_fn,
+    user_data: *mut c_void,
+    free_user_data: fricont_free_fn,
+) -> fricont_status {
+    // Owned from here on: dropped (finalised) on every path out that does not keep it.
+    let user = UserData {
+        ptr: user_data,
+        free: free_user_data,
+    };
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let new = monitor.map(|f| Arc::new(Monitor { f, user }));
+        let old = std::mem::replace(&mut h.lock()?.monitor, new);
+        // The old monitor's user data is finalised after the handle is released.
+        drop(old);
         Ok(fricont_status::FRICONT_OK)
     })
 }
@@ -664,7 +793,7 @@ pub unsafe extern "C" fn fricont_path_start(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         let guess = if guess.is_null() {
             None
         } else {
@@ -698,6 +827,7 @@ pub unsafe extern "C" fn fricont_path_start(
             let mut opts = PathOptions::window(a0, a1);
             opts.max_steps = h.max_steps;
             opts.zero_tol = h.zero_tol;
+            opts.max_alpha_step = h.max_alpha_step;
             h.path = Some(Path::new(h.problem.clone(), load, opts)?);
         }
         h.solutions.clear();
@@ -737,14 +867,16 @@ pub unsafe extern "C" fn fricont_path_step(path: *mut fricont_path) -> fricont_s
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         let outcome = h.started_mut()?.step()?;
         Ok(outcome_status(&outcome))
     })
 }
 
-/// Steps until the path ends. Returns `FRICONT_END` (see `fricont_path_end_reason`) or the
-/// first error of `fricont_path_step`.
+/// Steps until the path ends, calling the monitor (`fricont_path_set_monitor`), if any,
+/// after each transition point. Returns `FRICONT_END` (see `fricont_path_end_reason`:
+/// `FRICONT_END_STOPPED` when the monitor stopped it) or the first error of
+/// `fricont_path_step`.
 ///
 /// # Safety
 /// `path` is NULL or a live handle.
@@ -753,9 +885,34 @@ pub unsafe extern "C" fn fricont_path_run(path: *mut fricont_path) -> fricont_st
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
-        h.started_mut()?.run()?;
-        Ok(fricont_status::FRICONT_END)
+        loop {
+            // The handle is released while the monitor runs, so that it can read the path.
+            let (progress, monitor) = {
+                let mut inner = h.lock()?;
+                if let StepOutcome::End(_) = inner.started_mut()?.step()? {
+                    return Ok(fricont_status::FRICONT_END);
+                }
+                let progress = inner.started()?.progress();
+                (progress, inner.monitor.clone())
+            };
+            if let (Some(pr), Some(m)) = (progress, monitor) {
+                // SAFETY: the caller's monitor, called with its own user data.
+                let rc = unsafe {
+                    (m.f)(
+                        pr.alpha,
+                        pr.transitions as i64,
+                        pr.events.start as i64,
+                        pr.events.end as i64,
+                        m.user.ptr,
+                    )
+                };
+                if rc != 0 {
+                    let mut inner = h.lock()?;
+                    inner.started_mut()?.stop();
+                    return Ok(fricont_status::FRICONT_END);
+                }
+            }
+        }
     })
 }
 
@@ -775,7 +932,7 @@ pub unsafe extern "C" fn fricont_path_end_reason(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let h = h.read()?;
         if reason.is_null() {
             return Err(Failure::null("reason"));
         }
@@ -786,6 +943,7 @@ pub unsafe extern "C" fn fricont_path_end_reason(
             Some(EndReason::ClosedLoop) => fricont_end_reason::FRICONT_END_CLOSED_LOOP,
             Some(EndReason::Bifurcation) => fricont_end_reason::FRICONT_END_BIFURCATION,
             Some(EndReason::Failed(_)) => fricont_end_reason::FRICONT_END_FAILED,
+            Some(EndReason::Stopped) => fricont_end_reason::FRICONT_END_STOPPED,
         };
         // SAFETY: non-NULL and valid by contract.
         unsafe { reason.write(code as i32) };
@@ -830,7 +988,7 @@ unsafe fn write_count(
 ) -> FfiResult<fricont_status> {
     // SAFETY: NULL or a live handle, by contract.
     let h = unsafe { handle_ref(path, "path") }?;
-    let h = h.inner.borrow();
+    let h = h.read()?;
     if count.is_null() {
         return Err(Failure::null("count"));
     }
@@ -877,7 +1035,7 @@ pub unsafe extern "C" fn fricont_path_event(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let h = h.read()?;
         if out.is_null() {
             return Err(Failure::null("out"));
         }
@@ -923,7 +1081,7 @@ pub unsafe extern "C" fn fricont_path_event_state(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let h = h.read()?;
         let path = h.started()?;
         let k = index_in(k, path.events().len(), "event")?;
         let st = path.event_state(k)?;
@@ -948,7 +1106,7 @@ pub unsafe extern "C" fn fricont_path_start_state(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let h = h.read()?;
         let st = h
             .started()?
             .start_state()
@@ -975,7 +1133,7 @@ pub unsafe extern "C" fn fricont_path_current(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         let st = h.started_mut()?.current()?;
         h.fill_state(&st, state)?;
         Ok(fricont_status::FRICONT_OK)
@@ -1021,7 +1179,7 @@ pub unsafe extern "C" fn fricont_path_piece(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let h = h.read()?;
         let pieces = h.started()?.pieces();
         let pc = &pieces[index_in(k, pieces.len(), "piece")?];
         // SAFETY: NULL or valid for `classes_len` writes, by contract.
@@ -1079,7 +1237,7 @@ pub unsafe extern "C" fn fricont_path_branch(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let h = h.read()?;
         let branches = h.started()?.branches();
         let b = &branches[index_in(k, branches.len(), "branch")?];
         // SAFETY: NULL or valid for `classes_len` writes, by contract.
@@ -1113,7 +1271,7 @@ pub unsafe extern "C" fn fricont_path_choose_branch(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         let p = h.started_mut()?;
         let count = p.branches().len();
         if count == 0 {
@@ -1149,7 +1307,7 @@ pub unsafe extern "C" fn fricont_path_solutions_at(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let mut h = h.inner.borrow_mut();
+        let mut h = h.lock()?;
         if count.is_null() {
             return Err(Failure::null("count"));
         }
@@ -1186,7 +1344,7 @@ pub unsafe extern "C" fn fricont_path_solution(
     ffi_boundary!(path => {
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
-        let h = h.inner.borrow();
+        let h = h.read()?;
         h.started()?;
         let s = &h.solutions[index_in(k, h.solutions.len(), "solution")?];
         h.fill_state(&s.state, state)?;

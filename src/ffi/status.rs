@@ -59,7 +59,8 @@ pub enum fricont_status {
     FRICONT_ERR_RANGE = -103,
     /// Usage: a call made in the wrong order (querying or stepping a path that was not
     /// started, setting path options after the start, choosing a branch where there is no
-    /// bifurcation, starting without an α window).
+    /// bifurcation, starting without an α window), or a call into a path from inside one
+    /// of its own load callbacks (which would re-enter a step under way).
     FRICONT_ERR_ORDER = -104,
     /// Usage: the displacement u was asked of a problem that cannot compute it (made by
     /// `fricont_problem_new_condensed`): pass NULL for u there.
@@ -151,7 +152,9 @@ impl fricont_status {
             FRICONT_ERR_NULL => "FRICONT_ERR_NULL: a required pointer argument is NULL\0",
             FRICONT_ERR_LENGTH => "FRICONT_ERR_LENGTH: an array length or dimension does not fit\0",
             FRICONT_ERR_RANGE => "FRICONT_ERR_RANGE: a parameter is out of its range\0",
-            FRICONT_ERR_ORDER => "FRICONT_ERR_ORDER: a call made in the wrong order\0",
+            FRICONT_ERR_ORDER => {
+                "FRICONT_ERR_ORDER: a call made in the wrong order, or into a path from its own load callback\0"
+            }
             FRICONT_ERR_UNAVAILABLE => {
                 "FRICONT_ERR_UNAVAILABLE: u is not available for a problem made from condensed data\0"
             }
@@ -245,6 +248,9 @@ pub enum fricont_end_reason {
     /// A failure (a load callback, numerics); the path keeps what it traced. The error
     /// message of the failing call says what happened.
     FRICONT_END_FAILED = 5,
+    /// The monitor (`fricont_path_set_monitor`) asked to stop. Not final:
+    /// `fricont_path_step` and `fricont_path_run` continue from where the path stopped.
+    FRICONT_END_STOPPED = 6,
 }
 
 /// A static, NUL-terminated description of a status code: the enumerator's name, a colon

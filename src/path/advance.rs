@@ -202,7 +202,8 @@ impl Path {
             Ok((pt, table))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha)?;
-        let mut h = (span / 32.0).min((bound - cur.alpha).abs());
+        let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
+        let mut h = (span / 32.0).min(hmax).min((bound - cur.alpha).abs());
         let hmin = span * 1e-12;
         loop {
             let tol_at = self.tol_at(&pa);
@@ -299,7 +300,7 @@ impl Path {
                 }
                 pa = pb;
                 ga = gb;
-                h = (2.0 * h).min(span / 8.0);
+                h = (2.0 * h).min(hmax);
                 continue;
             }
             // Brent on each crossing guard; the earliest root wins.

@@ -49,6 +49,15 @@ pub struct PathOptions {
     /// one factorised base by rank-2 changes (O(m²) per piece; default `false`). The
     /// fresh factorisations are the reference the updated ones are tested against.
     pub fresh_factorisations: bool,
+    /// Largest α step of the step control of a basis or general (nonlinear) load (α
+    /// units; default `None`: 1/8 of the window's length). Each step is also shortened
+    /// until the cubic Hermite model of every guard predicts a fresh evaluation at the
+    /// step's midpoint; a load that varies faster than that test can see (an excursion of
+    /// a guard below zero and back, narrower than the step at which the test passes) is
+    /// caught only by a step no longer than the excursion: set this to a fraction of the
+    /// shortest period or feature of a load that oscillates. No effect on affine loads,
+    /// whose pieces are followed exactly. Must be finite and > 0.
+    pub max_alpha_step: Option<f64>,
 }
 
 impl PathOptions {
@@ -60,6 +69,7 @@ impl PathOptions {
             max_steps: 10_000,
             zero_tol: 1e-11,
             fresh_factorisations: false,
+            max_alpha_step: None,
         }
     }
 }
@@ -78,11 +88,14 @@ pub enum EndReason {
     Bifurcation,
     /// A failure (load callback, numerics); the message says which. What was traced is kept.
     Failed(String),
+    /// The monitor of [`Path::run_monitored`] asked to stop. Not final: [`Path::step`]
+    /// and the run functions continue from where the path stopped.
+    Stopped,
 }
 
 impl EndReason {
     /// The exchange-format name: `"window"`, `"max_steps"`, `"closed_loop"`,
-    /// `"bifurcation"`, `"failed"`.
+    /// `"bifurcation"`, `"failed"`, `"stopped"`.
     pub fn name(&self) -> &'static str {
         match self {
             EndReason::Window => "window",
@@ -90,6 +103,7 @@ impl EndReason {
             EndReason::ClosedLoop => "closed_loop",
             EndReason::Bifurcation => "bifurcation",
             EndReason::Failed(_) => "failed",
+            EndReason::Stopped => "stopped",
         }
     }
 }
@@ -203,8 +217,22 @@ pub enum StepOutcome {
         bifurcation: bool,
     },
     /// The path ended (it may be resumed after [`EndReason::Bifurcation`] by choosing a
-    /// branch).
+    /// branch, and after [`EndReason::Stopped`] by stepping on).
     End(EndReason),
+}
+
+/// What the monitor of [`Path::run_monitored`] is told after each transition point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Progress {
+    /// α of the transition point just passed.
+    pub alpha: f64,
+    /// Transition points traced so far (events of one degenerate transition count once).
+    pub transitions: usize,
+    /// The new events: a range of [`Path::events`] (one per node that changed class).
+    pub events: std::ops::Range<usize>,
+    /// α's position in the window, `(α − α_start) / (α_end − α_start)` (in [0, 1] inside
+    /// the window; a path that folds back may move both ways).
+    pub fraction: f64,
 }
 
 /// A path on a shared problem with its own load. `Send`, not `Sync`: one thread at a time.
@@ -434,7 +462,7 @@ const MAX_CANDIDATE_PIECES: usize = 4096;
 impl Path {
     /// Binds a load to a problem. Computes the condensed load vectors (one back-solve per
     /// basis vector). Errors: load length ≠ n; window bounds not finite or equal;
-    /// `zero_tol` not in (0, 1e-3].
+    /// `zero_tol` not in (0, 1e-3]; `max_alpha_step` not finite and > 0.
     pub fn new(problem: Arc<Problem>, load: Load, opts: PathOptions) -> Result<Path> {
         if !opts.alpha_start.is_finite()
             || !opts.alpha_end.is_finite()
@@ -443,6 +471,13 @@ impl Path {
             return Err(Error::InvalidParameter(format!(
                 "alpha window [{}, {}] must be finite with distinct ends",
                 opts.alpha_start, opts.alpha_end
+            )));
+        }
+        if let Some(h) = opts.max_alpha_step
+            && !(h.is_finite() && h > 0.0)
+        {
+            return Err(Error::InvalidParameter(format!(
+                "max_alpha_step = {h} must be finite and > 0"
             )));
         }
         if !(opts.zero_tol > 0.0 && opts.zero_tol <= 1e-3) {
@@ -929,8 +964,10 @@ impl Path {
     /// (likewise).
     pub fn step(&mut self) -> Result<StepOutcome> {
         let tr = self.trace_ref()?;
-        if let Some(r) = &tr.end {
-            return Ok(StepOutcome::End(r.clone()));
+        match &tr.end {
+            Some(EndReason::Stopped) => self.trace.as_mut().expect("started").end = None,
+            Some(r) => return Ok(StepOutcome::End(r.clone())),
+            None => {}
         }
         match self.step_inner() {
             Ok(o) => Ok(o),
@@ -986,11 +1023,61 @@ impl Path {
         last.lambda_to = user;
     }
 
-    /// Steps until the path ends; returns why.
+    /// Ends a started path that has not ended with [`EndReason::Stopped`] and returns true
+    /// (false, changing nothing, when it is not started or has ended). What was traced is
+    /// kept; [`Path::step`] continues from where it stopped. This is what a monitor's stop
+    /// does; a host that steps by itself may use it to mark why it stopped.
+    pub fn stop(&mut self) -> bool {
+        match self.trace.as_mut() {
+            Some(tr) if tr.end.is_none() => {
+                tr.end = Some(EndReason::Stopped);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    /// The progress after the last transition point (None before the first one).
+    pub fn progress(&self) -> Option<Progress> {
+        let tr = self.trace.as_ref()?;
+        let last = tr.events.last()?;
+        let first = tr
+            .events
+            .iter()
+            .rposition(|e| e.transition != last.transition)
+            .map_or(0, |k| k + 1);
+        let (a0, a1) = (self.opts.alpha_start, self.opts.alpha_end);
+        Some(Progress {
+            alpha: last.alpha,
+            transitions: tr.transitions,
+            events: first..tr.events.len(),
+            fraction: (last.alpha - a0) / (a1 - a0),
+        })
+    }
+
+    /// Steps until the path ends; returns why. Errors: those of [`Path::step`].
     pub fn run(&mut self) -> Result<EndReason> {
+        self.run_monitored(|_, _| std::ops::ControlFlow::Continue(()))
+    }
+
+    /// Steps until the path ends, calling `monitor` after each transition point with the
+    /// path (to read the new events) and the [`Progress`]. Returning
+    /// `ControlFlow::Break(())` ends the path with [`EndReason::Stopped`], keeping
+    /// everything traced; stepping or running it again continues from there. Returns why
+    /// the path ended. Errors: those of [`Path::step`].
+    pub fn run_monitored(
+        &mut self,
+        mut monitor: impl FnMut(&Path, &Progress) -> std::ops::ControlFlow<()>,
+    ) -> Result<EndReason> {
         loop {
-            if let StepOutcome::End(r) = self.step()? {
-                return Ok(r);
+            match self.step()? {
+                StepOutcome::End(r) => return Ok(r),
+                StepOutcome::Transition { .. } => {
+                    let progress = self.progress().expect("a transition was just passed");
+                    if monitor(self, &progress).is_break() && self.stop() {
+                        return Ok(EndReason::Stopped);
+                    }
+                }
             }
         }
     }
