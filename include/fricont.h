@@ -507,7 +507,9 @@ typedef struct fricont_event {
      */
     bool bifurcation;
     /**
-     * ‖H‖∞ at the transition point over max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞): a normwise backward error (dimensionless).
+     * ‖H‖∞ at the transition point over max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞,
+     * r‖|B||u|‖∞, r‖g‖∞, r‖W‖∞‖λ‖∞) (W = B A⁻¹ Bᵀ with unit contact rows): a normwise
+     * backward error (dimensionless).
      */
     double residual;
 } fricont_event;

@@ -37,8 +37,17 @@ fn split(lu: Mat<f64>) -> (Mat<f64>, Mat<f64>) {
     (l, u)
 }
 
-/// LU with partial (row) pivoting of an m × n matrix.
-pub(crate) fn partial_piv_lu(a: MatRef<'_, f64>) -> Lu {
+/// `P A = L U` of a square matrix with partial (row) pivoting, both factors packed in
+/// one matrix (`L` unit lower below the diagonal, `U` on and above it): a solve reads
+/// m² numbers, once.
+pub(crate) struct PartialLu {
+    pub lu: Mat<f64>,
+    /// Row `i` of `P A` is row `row_fwd[i]` of A.
+    pub row_fwd: Vec<usize>,
+}
+
+/// LU with partial (row) pivoting of a square matrix.
+pub(crate) fn partial_piv_lu(a: MatRef<'_, f64>) -> PartialLu {
     let (m, n) = a.shape();
     let mut lu = a.to_owned();
     let mut fwd = vec![0usize; m];
@@ -58,12 +67,25 @@ pub(crate) fn partial_piv_lu(a: MatRef<'_, f64>) -> Lu {
         MemStack::new(&mut mem),
         Default::default(),
     );
-    let (l, u) = split(lu);
-    Lu {
-        l,
-        u,
-        row_fwd: fwd,
-        col_fwd: (0..n).collect(),
+    PartialLu { lu, row_fwd: fwd }
+}
+
+impl PartialLu {
+    /// Solves `A X = B` in place (every column of `rhs`).
+    pub(crate) fn solve_in_place(&self, mut rhs: MatMut<'_, f64>) {
+        let n = rhs.nrows();
+        let mut b = vec![0.0; n];
+        for c in 0..rhs.ncols() {
+            for (i, v) in b.iter_mut().enumerate() {
+                *v = rhs[(self.row_fwd[i], c)];
+            }
+            for (i, v) in b.iter().enumerate() {
+                rhs[(i, c)] = *v;
+            }
+        }
+        // The triangular solves read only their own triangle of the packed factor.
+        solve_unit_lower_triangular_in_place(self.lu.as_ref(), rhs.as_mut(), Par::Seq);
+        solve_upper_triangular_in_place(self.lu.as_ref(), rhs.as_mut(), Par::Seq);
     }
 }
 
@@ -96,22 +118,6 @@ pub(crate) fn full_piv_lu(a: MatRef<'_, f64>) -> Lu {
         u,
         row_fwd: rf,
         col_fwd: cf,
-    }
-}
-
-impl Lu {
-    /// Solves `A X = B` in place for a square A factorised with partial pivoting.
-    pub(crate) fn solve_in_place(&self, mut rhs: MatMut<'_, f64>) {
-        let n = rhs.nrows();
-        for c in 0..rhs.ncols() {
-            let b: Vec<f64> = (0..n).map(|i| rhs[(self.row_fwd[i], c)]).collect();
-            for (i, v) in b.into_iter().enumerate() {
-                rhs[(i, c)] = v;
-            }
-        }
-        solve_unit_lower_triangular_in_place(self.l.as_ref(), rhs.as_mut(), Par::Seq);
-        solve_upper_triangular_in_place(self.u.as_ref(), rhs.as_mut(), Par::Seq);
-        // (partial pivoting: no column permutation)
     }
 }
 

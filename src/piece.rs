@@ -282,7 +282,7 @@ pub(crate) fn shift_gap(q: &[f64], gap: &[f64]) -> Vec<f64> {
 
 /// Result of an LU with partial pivoting: solves and the sign of the determinant.
 pub(crate) struct DenseLu {
-    lu: crate::dense::Lu,
+    lu: crate::dense::PartialLu,
     /// Sign of the determinant (0 when a pivot is exactly 0).
     pub det_sign: i8,
     /// min |U_ii| / max |U_ii|: a cheap singularity indicator.
@@ -292,7 +292,7 @@ pub(crate) struct DenseLu {
 impl DenseLu {
     pub fn new(a: MatRef<'_, f64>) -> Self {
         let lu = crate::dense::partial_piv_lu(a);
-        let u = &lu.u;
+        let u = &lu.lu;
         let n = u.nrows();
         let mut sign: i8 = perm_parity(&lu.row_fwd);
         let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
@@ -320,6 +320,16 @@ impl DenseLu {
         let xm = faer::MatMut::from_column_major_slice_mut(&mut x, n, 1);
         self.lu.solve_in_place(xm);
         x
+    }
+
+    /// Solves for every column of `b` in place.
+    pub fn solve_mat(&self, b: faer::MatMut<'_, f64>) {
+        self.lu.solve_in_place(b);
+    }
+
+    /// The order of the matrix.
+    pub fn n(&self) -> usize {
+        self.lu.lu.nrows()
     }
 }
 
@@ -477,12 +487,16 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// H1 = A u − f(α) − Nᵀ λν − Tᵀ λt
 /// H2 = λν − min(λν − r (N u − g), 0)
 /// H3 = λt − P_[−b, b](λt − r T u),   b = max(−F λν, 0)
-/// residual = ‖(H1, H2, H3)‖∞ / max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞)
+/// residual = ‖(H1, H2, H3)‖∞ / max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞,
+///                                   r‖W‖∞‖λ‖∞)
 /// ```
 ///
 /// The scale is the largest magnitude among the terms of the equations, taken entry by
 /// entry (`|A||u|` rather than `A u`), as in a normwise backward error: it is what
 /// rounding errors are proportional to, and it does not depend on the units of u or f.
+/// The last term is the size of the terms that `B u = q + W λ` is made of: at a contact
+/// node `B u` vanishes by cancellation inside u (`|B||u|` is 0 there), while its rounding
+/// is that of `W λ`, which H2 and H3 multiply by r.
 ///
 /// Without A (a host's solve, or condensed input) H1 is not evaluated. With a host's
 /// solve `B u` comes from its u; for condensed input (u empty, `f` the condensed load q)
@@ -549,6 +563,8 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
             .max(r * bu_abs[p + i])
             .max(r * g.abs());
     }
+    let lam_max = lam.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    scale = scale.max(r * problem.w_norm() * lam_max);
     if h.is_nan() { f64::INFINITY } else { h / scale }
 }
 

@@ -572,6 +572,10 @@ impl ProblemBuilder {
         let r_default = delassus.default_r();
         let r = self.r.unwrap_or(r_default);
         check_r(r, r_default)?;
+        let w = delassus.w();
+        let w_norm = (0..w.nrows())
+            .map(|k| w.col(k).iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0f64, f64::max);
         Ok(Problem {
             n: n_dofs,
             p,
@@ -583,6 +587,7 @@ impl ProblemBuilder {
             node_scale,
             r,
             r_default,
+            w_norm,
             delassus,
         })
     }
@@ -896,6 +901,8 @@ pub struct Problem {
     node_scale: Vec<f64>,
     r: f64,
     r_default: f64,
+    /// `‖W‖∞` (equilibrated rows).
+    w_norm: f64,
     delassus: std::sync::Arc<Delassus>,
 }
 
@@ -961,6 +968,10 @@ impl Problem {
     pub fn default_r(&self) -> f64 {
         self.r_default
     }
+    /// `‖W‖∞`, the largest absolute row sum of W (equilibrated rows; length per force).
+    pub fn w_norm(&self) -> f64 {
+        self.w_norm
+    }
     /// The condensation (Cholesky of A, W).
     pub fn delassus(&self) -> &Delassus {
         &self.delassus
@@ -980,6 +991,7 @@ impl Problem {
             node_scale: self.node_scale.clone(),
             r,
             r_default: self.r_default,
+            w_norm: self.w_norm,
             delassus: self.delassus.clone(),
         })
     }

@@ -160,7 +160,8 @@ impl<'a> PieceSolves<'a> {
             .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
             .and_then(|u| u.extend(self.c, self.w, classes));
         if let Some(u) = extended {
-            let (x, rel) = u.solve_checked(self.c, self.w, &rhs, self.row_bound);
+            let crate::path::update::Checked { x, rel, .. } =
+                u.solve_checked(self.c, self.w, &rhs, self.row_bound);
             if rel <= 1e-12 && x.iter().all(|v| v.is_finite()) {
                 self.lu = Some(u);
                 return Some(x);
@@ -171,7 +172,7 @@ impl<'a> PieceSolves<'a> {
         if u.pivot_ratio() < 1e-14 {
             return None;
         }
-        let (x, _) = u.solve_checked(self.c, self.w, &rhs, self.row_bound);
+        let x = u.solve_checked(self.c, self.w, &rhs, self.row_bound).x;
         self.lu = Some(u);
         x.iter().all(|v| v.is_finite()).then_some(x)
     }

@@ -106,7 +106,9 @@ pub struct fricont_event {
     pub fold: bool,
     /// More than one neighbouring piece continues the path here.
     pub bifurcation: bool,
-    /// ‖H‖∞ at the transition point over max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞): a normwise backward error (dimensionless).
+    /// ‖H‖∞ at the transition point over max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞,
+    /// r‖|B||u|‖∞, r‖g‖∞, r‖W‖∞‖λ‖∞) (W = B A⁻¹ Bᵀ with unit contact rows): a normwise
+    /// backward error (dimensionless).
     pub residual: f64,
 }
 

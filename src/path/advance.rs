@@ -22,26 +22,24 @@ pub(super) enum Exit {
 }
 
 impl Path {
-    /// Values and derivatives along `t` of all guards of `classes` at `pt`.
+    /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
+    /// with the rate of d along it (`W t_λ + q' t_α`, see [`Path::rate_along`]).
     pub(super) fn guard_table(
         &self,
         classes: &[Class],
         pt: &Point,
-        t: Option<&[f64]>,
+        t: Option<(&[f64], &[f64])>,
     ) -> Vec<GuardRow> {
         let c = self.consts();
         let m = 2 * c.p;
-        let w = self.problem.delassus().w();
         let d = self.gaps(pt);
+        let zeros;
         let (lt, dt) = match t {
-            Some(t) => {
-                let mut dd = displacement_gaps(w, &vec![0.0; m], &t[..m]);
-                for (k, v) in dd.iter_mut().enumerate() {
-                    *v += pt.dq[k] * t[m];
-                }
-                (t[..m].to_vec(), dd)
+            Some((t, rate)) => (&t[..m], rate),
+            None => {
+                zeros = vec![0.0; m];
+                (&zeros[..], &zeros[..])
             }
-            None => (vec![0.0; m], vec![0.0; m]),
         };
         c.guards(classes)
             .into_iter()
@@ -50,7 +48,7 @@ impl Path {
                 GuardRow {
                     guard: g,
                     value: f.eval(&pt.lam, &d),
-                    slope: f.eval(&lt, &dt),
+                    slope: f.eval(lt, dt),
                 }
             })
             .collect()
@@ -62,7 +60,7 @@ impl Path {
         let m = 2 * self.problem.p();
         let pt = self.point_at(cur.lam.clone(), cur.alpha)?;
         let tol = self.tol_at(&pt);
-        let table = self.guard_table(&cur.classes, &pt, Some(&cur.t));
+        let table = self.guard_table(&cur.classes, &pt, Some((&cur.t, &cur.rate)));
         let mut best: Option<(f64, Guard)> = None;
         for &GuardRow {
             guard: g,
@@ -98,8 +96,13 @@ impl Path {
                 let alpha = if ta > 0.0 { hi } else { lo };
                 let pt = self.point_at(vec![0.0; m], alpha)?;
                 let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
-                let mlu = DenseLu::new(c.piece_matrix(w, &cur.classes).as_ref());
-                let lam = mlu.solve(&c.piece_rhs(&cur.classes, &qg));
+                let rhs = c.piece_rhs(&cur.classes, &qg);
+                let lam = match &*cur.lu {
+                    PieceSolver::Updated(u) => u.solve_checked(&c, w, &rhs, self.row_bound()).x,
+                    PieceSolver::Full(_) => {
+                        DenseLu::new(c.piece_matrix(w, &cur.classes).as_ref()).solve(&rhs)
+                    }
+                };
                 Ok(Exit::Window(Point { lam, ..pt }))
             }
             (Some((s, g)), _) => {
@@ -124,16 +127,24 @@ impl Path {
                             .map(|(a, b)| a * b)
                             .sum::<f64>()
                         - row[m] * cur.alpha;
-                    let dq_col = self.alpha_column(&cur.classes, &pt.dq);
-                    let xp = cur.lu.particular_raw(
-                        &c,
-                        w,
-                        &rhs,
-                        cur.alpha,
-                        &dq_col,
-                        cur.scales,
-                        self.row_bound(),
-                    );
+                    // The piece's point at the entry α was solved from the data with the
+                    // tangent (updated factorisations); else one particular solve.
+                    let xp = if let Some(xp) = &cur.xp {
+                        let mut x = xp.to_vec();
+                        x.push(cur.alpha);
+                        x
+                    } else {
+                        let dq_col = self.alpha_column(&cur.classes, &pt.dq);
+                        cur.lu.particular_raw(
+                            &c,
+                            w,
+                            &rhs,
+                            cur.alpha,
+                            &dq_col,
+                            cur.scales,
+                            self.row_bound(),
+                        )
+                    };
                     let dot = |x: &[f64]| row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
                     let tau = (-c0 - dot(&xp)) / dot(&cur.t);
                     let x: Vec<f64> = xp.iter().zip(&cur.t).map(|(a, b)| a + tau * b).collect();
@@ -183,7 +194,7 @@ impl Path {
                         b,
                         this.row_bound(),
                     )
-                    .0
+                    .x
                 }
                 (None, PieceSolver::Full(_)) => unreachable!("a full solver has its dense LU"),
             }
@@ -197,8 +208,9 @@ impl Path {
             let dl = msolve(this, &c.piece_rhs(&classes, &dq));
             let mut t = dl;
             t.push(1.0);
+            let rate = this.rate_along(&t, &dq);
             let pt = Point { lam, alpha, q, dq };
-            let table = this.guard_table(&classes, &pt, Some(&t));
+            let table = this.guard_table(&classes, &pt, Some((&t, &rate)));
             Ok((pt, table))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha)?;

@@ -66,13 +66,17 @@ impl Path {
             lu,
             scales,
             orientation: lu_orientation,
+            rate,
+            xp,
         }) = self.tangent(classes, pt, scale)
         else {
             return;
         };
         let lu = Arc::new(lu);
         // One table along t; along −t the slopes change sign.
-        let table = self.guard_table(classes, pt, Some(&t));
+        let table = self.guard_table(classes, pt, Some((&t, &rate)));
+        let rate = Arc::new(rate);
+        let xp = xp.map(Arc::new);
         for s in [1.0, -1.0] {
             let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
             if out.iter().any(|c| {
@@ -85,7 +89,11 @@ impl Path {
                 let (v, vd) = (row.value, s * row.slope);
                 // Values against the guard's own threshold; slopes (force per unit of
                 // scaled arclength) against the scale of the point.
-                let (tv, ts) = (tol.of(&c.guard_form(row.guard)), tol.slope());
+                let form = c.guard_form(row.guard);
+                if v > tol.upper(&form) {
+                    return true;
+                }
+                let (tv, ts) = (tol.of(&form), tol.slope());
                 if v > tv {
                     true
                 } else if v < -tv {
@@ -108,6 +116,11 @@ impl Path {
                 } else {
                     orientation * sign(ts[m])
                 };
+                let rate = if s > 0.0 {
+                    rate.clone()
+                } else {
+                    Arc::new(rate.iter().map(|v| -v).collect())
+                };
                 out.push(Candidate {
                     orientation,
                     classes: classes.to_vec(),
@@ -115,6 +128,8 @@ impl Path {
                     det_sign,
                     lu: lu.clone(),
                     scales,
+                    rate,
+                    xp: xp.clone(),
                 });
             }
         }
@@ -250,7 +265,8 @@ impl Path {
             guard: g, value: v, ..
         } in self.guard_table(&cur.classes, &pt, None)
         {
-            if v <= tol.of(&c.guard_form(g)) {
+            let form = c.guard_form(g);
+            if v <= tol.upper(&form) && v <= tol.of(&form) {
                 nodes.push(g.node);
             }
         }
@@ -438,16 +454,26 @@ impl Path {
             t: cand.t.clone(),
             lu: cand.lu.clone(),
             scales: cand.scales,
+            rate: cand.rate.clone(),
+            xp: cand.xp.clone(),
         };
         let events = pend.events_start..tr.events.len();
-        let closed = tr.entries.iter().any(|e| {
-            e.classes == cand.classes
-                && (e.alpha - pt.alpha).abs() <= 1e-9 * a_s
-                && e.lam
-                    .iter()
-                    .zip(&pt.lam)
-                    .all(|(x, y)| (x - y).abs() <= 1e-9 * scale)
+        let key = classes_hash(&cand.classes);
+        let closed = tr.entry_index.get(&key).is_some_and(|ks| {
+            ks.iter().any(|&k| {
+                let e = &tr.entries[k];
+                e.classes == cand.classes
+                    && (e.alpha - pt.alpha).abs() <= 1e-9 * a_s
+                    && e.lam
+                        .iter()
+                        .zip(&pt.lam)
+                        .all(|(x, y)| (x - y).abs() <= 1e-9 * scale)
+            })
         });
+        tr.entry_index
+            .entry(key)
+            .or_default()
+            .push(tr.entries.len());
         tr.entries.push(PieceEntry {
             classes: cand.classes.clone(),
             lam: pt.lam.clone(),

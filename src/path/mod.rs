@@ -250,8 +250,11 @@ pub struct Path {
     /// The last `d = q − (g, 0) + W λ` with its (α, λ): every candidate piece at a
     /// transition point needs it.
     gaps_cache: RefCell<Option<GapsAt>>,
-    /// `|W|` entry by entry (for the rounding scale of `W λ`), made on first use.
-    abs_w: RefCell<Option<Arc<faer::Mat<f64>>>>,
+    /// The absolute row sums of W, `|W| 1` (bounds of the rounding scale of `W λ`), made
+    /// on first use.
+    abs_row_sums: RefCell<Option<Arc<Vec<f64>>>>,
+    /// The last point's "at zero" thresholds with its (α, λ).
+    tol_cache: RefCell<Option<(f64, Vec<f64>, Tol)>>,
 }
 
 /// The traced data and the current position.
@@ -272,20 +275,65 @@ struct Trace {
     event_loads: Vec<LoadSnapshot>,
     /// Entry points of the pieces: (classes, λ, α), for closed-loop detection.
     entries: Vec<PieceEntry>,
+    /// The entries by a hash of their classes.
+    entry_index: std::collections::HashMap<u64, Vec<usize>>,
     /// The last transition, kept while a branch may still be chosen there.
     pending: Option<PendingJoin>,
     branches: Vec<Branch>,
 }
 
 /// "At zero" thresholds at a point, in force units: `force` for a form in λ only (per
-/// unit of its coefficients); for a form with a displacement term `d_k`, `rows[k]`, the
-/// threshold of that row of `d = q − (g, 0) + W λ` (relative to the magnitude of the
-/// terms that make it up); `disp` is the largest of them.
+/// unit of its coefficients); for a form with a displacement term `d_k`, the threshold of
+/// that row of `d = q − (g, 0) + W λ`, relative to the magnitude of the terms that make it
+/// up (see [`Path::tol_at`]); `disp` is the point's threshold, the largest of them.
 #[derive(Clone, Debug)]
 pub(super) struct Tol {
     force: f64,
     disp: f64,
-    rows: Option<Arc<Vec<f64>>>,
+    rows: Option<Arc<TolRows>>,
+}
+
+/// The per-row thresholds of displacement forms, computed on first use: row k costs one
+/// pass over row k of W (`(|W| |λ|)_k`), so a transition pays only for the rows it asks.
+#[derive(Debug)]
+pub(super) struct TolRows {
+    problem: Arc<Problem>,
+    /// `zero_tol · r0`.
+    factor: f64,
+    /// `|q_k|ₜ + |g_k|` per row.
+    base: Vec<f64>,
+    abs_lam: Vec<f64>,
+    lam_max: f64,
+    /// `(|W| 1)_k`, for the cheap upper bounds.
+    row_sums: Arc<Vec<f64>>,
+    floor: f64,
+    /// The thresholds found so far, as f64 bits (NaN: not yet).
+    exact: Vec<std::sync::atomic::AtomicU64>,
+}
+
+impl TolRows {
+    fn exact(&self, k: usize) -> f64 {
+        use std::sync::atomic::Ordering::Relaxed;
+        let v = f64::from_bits(self.exact[k].load(Relaxed));
+        if !v.is_nan() {
+            return v;
+        }
+        // Row k of the symmetric W, read as its contiguous column k.
+        let col = self.problem.delassus().w().col(k);
+        let wl: f64 = col
+            .iter()
+            .zip(&self.abs_lam)
+            .map(|(w, l)| w.abs() * l)
+            .sum();
+        let v = (self.factor * (self.base[k] + wl)).max(self.floor);
+        self.exact[k].store(v.to_bits(), Relaxed);
+        v
+    }
+
+    /// An upper bound of [`Self::exact`] in O(1): `(|W||λ|)_k ≤ (|W| 1)_k ‖λ‖∞`.
+    fn upper(&self, k: usize) -> f64 {
+        (self.factor * (self.base[k] + self.row_sums[k] * self.lam_max)).max(self.floor)
+    }
 }
 
 impl Tol {
@@ -307,9 +355,20 @@ impl Tol {
     /// The threshold for a linear form.
     fn of(&self, f: &crate::piece::LinForm) -> f64 {
         if f.disp.coef != 0.0 {
-            self.rows.as_ref().map_or(self.disp, |r| r[f.disp.index])
+            self.rows
+                .as_ref()
+                .map_or(self.disp, |r| r.exact(f.disp.index))
         } else {
             self.force * (f.lam[0].coef.abs() + f.lam[1].coef.abs()).max(1.0)
+        }
+    }
+
+    /// An upper bound of [`Self::of`] that costs O(1): a value above it is above the
+    /// threshold without computing the threshold.
+    fn upper(&self, f: &crate::piece::LinForm) -> f64 {
+        match (&self.rows, f.disp.coef != 0.0) {
+            (Some(r), true) => r.upper(f.disp.index),
+            _ => self.of(f),
         }
     }
 }
@@ -328,6 +387,11 @@ struct CurrentPiece {
     /// Factorisation of the piece, with the scales of its Jacobian.
     lu: Arc<PieceSolver>,
     scales: JacobianScaling,
+    /// The rate of `d` along `t`: `W t_λ + q' t_α`.
+    rate: Arc<Vec<f64>>,
+    /// λ on the piece at the α where the path entered it, solved from the data with the
+    /// piece's updated factorisation (None for a full-pivoting solver).
+    xp: Option<Arc<Vec<f64>>>,
 }
 
 /// A transition point with its continuations, kept until the next step.
@@ -357,6 +421,10 @@ struct Candidate {
     det_sign: i8,
     lu: Arc<PieceSolver>,
     scales: JacobianScaling,
+    /// The rate of `d` along `t`.
+    rate: Arc<Vec<f64>>,
+    /// λ on the piece at the point, solved from the data (see [`CurrentPiece::xp`]).
+    xp: Option<Arc<Vec<f64>>>,
 }
 
 /// How a piece's equations are solved: a full-pivoting LU of the Jacobian in scaled
@@ -400,7 +468,7 @@ impl PieceSolver {
                     .zip(dq_col)
                     .map(|(bi, ci)| bi - ci * alpha)
                     .collect();
-                let (mut x, _) = u.solve_checked(c, w, &rhs, row_bound);
+                let mut x = u.solve_checked(c, w, &rhs, row_bound).x;
                 x.push(alpha);
                 x
             }
@@ -416,6 +484,10 @@ struct PieceTangent {
     scales: JacobianScaling,
     /// `sign det [J_S; tᵀ]`.
     orientation: i8,
+    /// The rate of `d` along `t`: `W t_λ + q' t_α`.
+    rate: Vec<f64>,
+    /// λ on the piece at the point's α (updated factorisations only).
+    xp: Option<Vec<f64>>,
 }
 
 /// The scaling of a piece Jacobian: λ is measured in units of `force`, α in units of
@@ -448,6 +520,14 @@ fn sign(x: f64) -> i8 {
     } else {
         0
     }
+}
+
+/// A hash of a class vector (for the closed-loop index).
+fn classes_hash(classes: &[Class]) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    classes.hash(&mut h);
+    h.finish()
 }
 
 fn inf_norm(v: &[f64]) -> f64 {
@@ -503,7 +583,8 @@ impl Path {
             refactorisations: Cell::new(0),
             row_bound: Cell::new(None),
             gaps_cache: RefCell::new(None),
-            abs_w: RefCell::new(None),
+            abs_row_sums: RefCell::new(None),
+            tol_cache: RefCell::new(None),
         })
     }
 
@@ -572,37 +653,56 @@ impl Path {
     /// forces, `max(‖λ‖∞, force scale / 10)` (the floor keeps the rounding of λ, which is
     /// relative to the load, below it where all forces vanish together).
     fn tol_at(&self, pt: &Point) -> Tol {
+        if let Some((a, lam, t)) = &*self.tol_cache.borrow()
+            && *a == pt.alpha
+            && *lam == pt.lam
+        {
+            return t.clone();
+        }
         // The rows of q come from solves with A, whose rounding is relative to the whole
         // vector: no row's threshold goes below 1e-3 of the point's.
         const ROW_FLOOR: f64 = 1e-3;
         let scale = self.force_scale(pt);
         let z = self.opts.zero_tol;
         let r0 = self.problem.default_r();
-        let w = self.problem.delassus().w();
         let m = pt.lam.len();
-        let abs_lam: Vec<f64> = pt.lam.iter().map(|v| v.abs()).collect();
-        let abs_w = self
-            .abs_w
+        let row_sums = self
+            .abs_row_sums
             .borrow_mut()
             .get_or_insert_with(|| {
-                Arc::new(faer::Mat::<f64>::from_fn(m, m, |i, j| w[(i, j)].abs()))
+                let w = self.problem.delassus().w();
+                Arc::new(
+                    (0..m)
+                        .map(|k| w.col(k).iter().map(|v| v.abs()).sum())
+                        .collect(),
+                )
             })
             .clone();
-        let wl = displacement_gaps(abs_w.as_ref().as_ref(), &vec![0.0; m], &abs_lam);
         let qt = self.term_rows(pt);
         let gap = self.problem.gap_equilibrated();
         let p = self.problem.p();
-        let rows: Vec<f64> = (0..m)
-            .map(|k| {
-                let g = if k < p { gap[k].abs() } else { 0.0 };
-                (z * r0 * (qt[k] + g + wl[k])).max(ROW_FLOOR * z * scale)
-            })
+        let base = (0..m)
+            .map(|k| qt[k] + if k < p { gap[k].abs() } else { 0.0 })
             .collect();
-        Tol {
+        let rows = TolRows {
+            problem: self.problem.clone(),
+            factor: z * r0,
+            base,
+            abs_lam: pt.lam.iter().map(|v| v.abs()).collect(),
+            lam_max: inf_norm(&pt.lam),
+            row_sums,
+            floor: ROW_FLOOR * z * scale,
+            exact: (0..m)
+                .map(|_| std::sync::atomic::AtomicU64::new(f64::NAN.to_bits()))
+                .collect(),
+        };
+        let tol = Tol {
             force: z * inf_norm(&pt.lam).max(0.1 * scale),
             disp: z * scale,
             rows: Some(Arc::new(rows)),
-        }
+        };
+        *self.tol_cache.borrow_mut() = Some((pt.alpha, pt.lam.clone(), tol.clone()));
+        tol
     }
 
     /// The unit of α at a point: the change of α that moves the load by the force scale,
@@ -705,6 +805,16 @@ impl Path {
         d
     }
 
+    /// The rate of `d` along `t` (raw coordinates): `W t_λ + q' t_α` (one product with W).
+    fn rate_along(&self, t: &[f64], dq: &[f64]) -> Vec<f64> {
+        let m = t.len() - 1;
+        let mut dd = displacement_gaps(self.problem.delassus().w(), &vec![0.0; m], &t[..m]);
+        for (v, q) in dd.iter_mut().zip(dq) {
+            *v += q * t[m];
+        }
+        dd
+    }
+
     /// Bound on the absolute row sums of every piece matrix (for residual checks).
     fn row_bound(&self) -> f64 {
         if let Some(b) = self.row_bound.get() {
@@ -764,9 +874,15 @@ impl Path {
             .iter()
             .map(|v| -v)
             .collect();
+        // The tangent's direction and the piece's point at this α, from the data, in one
+        // solve.
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+        let rhs = c.piece_rhs(classes, &qg);
         let solve = |u: &UpdatedLu| {
-            let (y, rel) = u.solve_checked(&c, w, &neg, rb);
-            (rel <= 1e-12).then_some(y)
+            let mut ch = u.solve_checked_many(&c, w, &[&neg, &rhs], rb);
+            let xp = ch.pop().expect("two columns");
+            let y = ch.pop().expect("two columns");
+            (y.rel <= 1e-12 && xp.rel <= 1e-12).then_some((y.x, y.wx, xp.x))
         };
         let extended = self
             .updater
@@ -774,7 +890,7 @@ impl Path {
             .as_ref()
             .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
             .and_then(|u| u.extend(&c, w, classes));
-        let (upd, y, fresh) = match extended.and_then(|u| solve(&u).map(|y| (u, y))) {
+        let (upd, (y, wy, xp), fresh) = match extended.and_then(|u| solve(&u).map(|y| (u, y))) {
             Some((u, y)) => (u, y, false),
             None => {
                 let u = UpdatedLu::factor(&c, w, classes)?;
@@ -797,11 +913,16 @@ impl Path {
         if fresh {
             *self.updater.borrow_mut() = Some(upd.clone());
         }
+        // t = (y, 1) / ‖(y/S, 1/A)‖, so the rate of d along t is (W y + q') by the same.
+        let k = t[m];
+        let rate = wy.iter().zip(&pt.dq).map(|(a, b)| k * (a + b)).collect();
         Some(PieceTangent {
             t,
             orientation: upd.det_sign(),
             lu: PieceSolver::Updated(upd),
             scales,
+            rate,
+            xp: Some(xp),
         })
     }
 
@@ -828,11 +949,14 @@ impl Path {
             *v *= scales.force;
         }
         t[m] *= scales.alpha;
+        let rate = self.rate_along(&t, &pt.dq);
         Some(PieceTangent {
             t,
             orientation: lu.orientation,
             lu: PieceSolver::Full(lu),
             scales,
+            rate,
+            xp: None,
         })
     }
 
@@ -933,6 +1057,7 @@ impl Path {
                 lam: pt.lam.clone(),
                 alpha,
             }],
+            entry_index: [(classes_hash(&cand.classes), vec![0])].into(),
             cur: CurrentPiece {
                 classes: cand.classes,
                 lam: pt.lam,
@@ -940,6 +1065,8 @@ impl Path {
                 t: cand.t,
                 lu: cand.lu,
                 scales: cand.scales,
+                rate: cand.rate,
+                xp: cand.xp,
             },
             end: None,
             sigma: cand.orientation,

@@ -31,7 +31,7 @@ use std::sync::{Arc, Mutex};
 use faer::MatRef;
 
 use crate::class::Class;
-use crate::piece::{DenseLu, PieceConstants, displacement_gaps};
+use crate::piece::{DenseLu, PieceConstants};
 
 /// Most updates kept on one base before a refactorisation: m/8 (at least 8). The
 /// border of C then costs O(m²) per update, like a solve, and a refactorisation
@@ -53,14 +53,16 @@ impl Base {
         cache
             .entry(node)
             .or_insert_with(|| {
+                // Both columns in one solve: the factor is read once.
                 let m = 2 * p;
-                let mut e = vec![0.0; m];
-                e[node] = 1.0;
-                let a = self.lu.solve(&e);
-                e[node] = 0.0;
-                e[p + node] = 1.0;
-                let b = self.lu.solve(&e);
-                Arc::new([a, b])
+                let mut e = faer::Mat::<f64>::zeros(m, 2);
+                e[(node, 0)] = 1.0;
+                e[(p + node, 1)] = 1.0;
+                self.lu.solve_mat(e.as_mut());
+                Arc::new([
+                    e.col(0).iter().copied().collect(),
+                    e.col(1).iter().copied().collect(),
+                ])
             })
             .clone()
     }
@@ -288,82 +290,171 @@ impl UpdatedLu {
         Some(())
     }
 
-    /// `(D_S M_S)⁻¹ b` (b already in `r0` units).
-    fn solve(&self, b: &[f64]) -> Vec<f64> {
-        let mut x = self.base.lu.solve(b);
+    /// `(D_S M_S)⁻¹ b` for every column `b` (already in `r0` units): one pass over the
+    /// base's factor for all of them, then the capacitance correction column by column.
+    fn solve(&self, bs: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let m = self.base.lu.n();
+        let mut xm = faer::Mat::<f64>::from_fn(m, bs.len(), |i, c| bs[c][i]);
+        self.base.lu.solve_mat(xm.as_mut());
         let k2 = 2 * self.updates.len();
-        if k2 == 0 {
-            return x;
-        }
-        let mut vx = vec![0.0; k2];
-        for (j, u) in self.updates.iter().enumerate() {
-            vx[2 * j] = dot(&u.v[0], &x);
-            vx[2 * j + 1] = dot(&u.v[1], &x);
-        }
-        let mut wv = vec![0.0; k2];
-        for (col, &v) in vx.iter().enumerate() {
-            if v != 0.0 {
-                for (r, o) in wv.iter_mut().enumerate() {
-                    *o += self.cinv[r + k2 * col] * v;
+        (0..bs.len())
+            .map(|c| {
+                let mut x: Vec<f64> = xm.col(c).iter().copied().collect();
+                if k2 == 0 {
+                    return x;
                 }
-            }
-        }
-        for (j, u) in self.updates.iter().enumerate() {
-            for a in 0..2 {
-                let c = wv[2 * j + a];
-                if c != 0.0 {
-                    for (xi, zi) in x.iter_mut().zip(&u.z[a]) {
-                        *xi -= c * zi;
+                let mut vx = vec![0.0; k2];
+                for (j, u) in self.updates.iter().enumerate() {
+                    vx[2 * j] = dot(&u.v[0], &x);
+                    vx[2 * j + 1] = dot(&u.v[1], &x);
+                }
+                let mut wv = vec![0.0; k2];
+                for (col, &v) in vx.iter().enumerate() {
+                    if v != 0.0 {
+                        for (r, o) in wv.iter_mut().enumerate() {
+                            *o += self.cinv[r + k2 * col] * v;
+                        }
                     }
                 }
-            }
-        }
-        x
+                for (j, u) in self.updates.iter().enumerate() {
+                    for a in 0..2 {
+                        let c = wv[2 * j + a];
+                        if c != 0.0 {
+                            for (xi, zi) in x.iter_mut().zip(&u.z[a]) {
+                                *xi -= c * zi;
+                            }
+                        }
+                    }
+                }
+                x
+            })
+            .collect()
     }
 
-    /// `M_S⁻¹ b` with one step of iterative refinement, and the relative residual
-    /// `‖D(b − M_S x)‖∞ / (‖|D M_S||x|‖∞ + ‖D b‖∞)` after it (D: the row scaling to `r0`
-    /// units; `|D M_S|` bounded row-wise by `row_bound`, see [`row_bound`]).
+    /// `M_S⁻¹ b` with its check (see [`Self::solve_checked_many`]).
     pub fn solve_checked(
         &self,
         c: &PieceConstants<'_>,
         w: MatRef<'_, f64>,
         b: &[f64],
         row_bound: f64,
-    ) -> (Vec<f64>, f64) {
-        let b = &scale_rhs(c, &self.classes, b);
+    ) -> Checked {
+        self.solve_checked_many(c, w, &[b], row_bound)
+            .pop()
+            .expect("one column")
+    }
+
+    /// `M_S⁻¹ b` for every `b` of `bs`, each with its relative residual
+    /// `‖D(b − M_S x)‖∞ / (‖|D M_S||x|‖∞ + ‖D b‖∞)` (D: the row scaling to `r0` units;
+    /// `|D M_S|` bounded row-wise by `row_bound`, see [`row_bound`]) and `W x` (the
+    /// product the residual needs, which callers reuse). A column is refined once only
+    /// when its first residual is above [`REFINE_ABOVE`]: the columns together then cost
+    /// one pass over the base's factor and one over W.
+    pub fn solve_checked_many(
+        &self,
+        c: &PieceConstants<'_>,
+        w: MatRef<'_, f64>,
+        bs: &[&[f64]],
+        row_bound: f64,
+    ) -> Vec<Checked> {
+        let bs: Vec<Vec<f64>> = bs.iter().map(|b| scale_rhs(c, &self.classes, b)).collect();
         let c = &equilibrated(c);
-        let mut x = self.solve(b);
-        let r = residual(c, w, &self.classes, &x, b);
-        let dx = self.solve(&r);
-        x.iter_mut().zip(&dx).for_each(|(a, d)| *a += d);
-        let r = residual(c, w, &self.classes, &x, b);
-        let xn = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let bn = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let rn = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let denom = row_bound * xn + bn;
-        let rel = if denom > 0.0 { rn / denom } else { rn };
-        (x, if rel.is_finite() { rel } else { f64::INFINITY })
+        let rel_of = |x: &[f64], r: &[f64], b: &[f64]| {
+            let bn = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let xn = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let rn = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let denom = row_bound * xn + bn;
+            let rel = if denom > 0.0 { rn / denom } else { rn };
+            if rel.is_finite() { rel } else { f64::INFINITY }
+        };
+        let xs = self.solve(&bs);
+        let checks = residuals(c, w, &self.classes, &xs, &bs);
+        let mut out: Vec<Checked> = xs
+            .into_iter()
+            .zip(checks)
+            .zip(&bs)
+            .map(|((x, (r, wx)), b)| Checked {
+                rel: rel_of(&x, &r, b),
+                x,
+                wx,
+                r,
+            })
+            .collect();
+        let again: Vec<usize> = (0..out.len())
+            .filter(|&k| out[k].rel > REFINE_ABOVE)
+            .collect();
+        if !again.is_empty() {
+            let rs: Vec<Vec<f64>> = again.iter().map(|&k| out[k].r.clone()).collect();
+            let dxs = self.solve(&rs);
+            let xs: Vec<Vec<f64>> = again
+                .iter()
+                .zip(dxs)
+                .map(|(&k, dx)| out[k].x.iter().zip(&dx).map(|(a, d)| a + d).collect())
+                .collect();
+            let b2: Vec<Vec<f64>> = again.iter().map(|&k| bs[k].clone()).collect();
+            let checks = residuals(c, w, &self.classes, &xs, &b2);
+            for ((&k, x), (r, wx)) in again.iter().zip(xs).zip(checks) {
+                out[k] = Checked {
+                    rel: rel_of(&x, &r, &bs[k]),
+                    x,
+                    wx,
+                    r,
+                };
+            }
+        }
+        out
     }
 }
 
-/// `b − M_S x` (one product with W).
-fn residual(
+/// A solve with its check: see [`UpdatedLu::solve_checked`].
+pub(crate) struct Checked {
+    /// The solution (λ units).
+    pub x: Vec<f64>,
+    /// Its relative residual.
+    pub rel: f64,
+    /// `W x`.
+    pub wx: Vec<f64>,
+    /// The residual `D (b − M_S x)`.
+    r: Vec<f64>,
+}
+
+/// Relative residual above which a solve is refined once (a few units of rounding: a
+/// backward-stable solve of a well-conditioned piece lands below it).
+pub(crate) const REFINE_ABOVE: f64 = 1e-15;
+
+/// `b − M_S x` and `W x` for every column (one product of W with all columns).
+fn residuals(
     c: &PieceConstants<'_>,
     w: MatRef<'_, f64>,
     classes: &[Class],
-    x: &[f64],
-    b: &[f64],
-) -> Vec<f64> {
-    let zeros = vec![0.0; x.len()];
-    let d = displacement_gaps(w, &zeros, x);
-    let mut r = b.to_vec();
-    for (i, &cls) in classes.iter().enumerate() {
-        let [nu, t] = c.equations(i, cls);
-        r[i] -= nu.eval(x, &d);
-        r[c.p + i] -= t.eval(x, &d);
-    }
-    r
+    xs: &[Vec<f64>],
+    bs: &[Vec<f64>],
+) -> Vec<(Vec<f64>, Vec<f64>)> {
+    let m = w.nrows();
+    let xm = faer::Mat::<f64>::from_fn(m, xs.len(), |i, k| xs[k][i]);
+    let mut dm = faer::Mat::<f64>::zeros(m, xs.len());
+    faer::linalg::matmul::matmul(
+        dm.as_mut(),
+        faer::Accum::Replace,
+        w,
+        xm.as_ref(),
+        1.0,
+        faer::Par::Seq,
+    );
+    xs.iter()
+        .zip(bs)
+        .enumerate()
+        .map(|(k, (x, b))| {
+            let d: Vec<f64> = dm.col(k).iter().copied().collect();
+            let mut r = b.clone();
+            for (i, &cls) in classes.iter().enumerate() {
+                let [nu, t] = c.equations(i, cls);
+                r[i] -= nu.eval(x, &d);
+                r[c.p + i] -= t.eval(x, &d);
+            }
+            (r, d)
+        })
+        .collect()
 }
 
 /// The largest absolute row sum of any piece matrix in `r0` units:
