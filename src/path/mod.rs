@@ -875,11 +875,30 @@ impl Path {
             .map(|v| -v)
             .collect();
         // The tangent's direction and the piece's point at this α, from the data, in one
-        // solve.
+        // solve. The point is found as a correction of the current λ, from its residual
+        // on this piece's equations (O(m) with the point's d): on a neighbouring piece
+        // that residual is at rounding level, and so is the correction's error.
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let rhs = c.piece_rhs(classes, &qg);
+        let d = self.gaps(pt);
+        let mut resid = vec![0.0; m];
+        for (i, &cl) in classes.iter().enumerate() {
+            let [nu, t] = c.equations(i, cl);
+            resid[i] = -nu.eval(&pt.lam, &d);
+            resid[c.p + i] = -t.eval(&pt.lam, &d);
+        }
         let solve = |u: &UpdatedLu| {
-            let mut ch = u.solve_checked_many(&c, w, &[&neg, &rhs], rb);
+            let cols = [
+                update::Rhs {
+                    b: &neg,
+                    guess: None,
+                },
+                update::Rhs {
+                    b: &rhs,
+                    guess: Some((&pt.lam, &resid)),
+                },
+            ];
+            let mut ch = u.solve_checked_many(&c, w, &cols, rb);
             let xp = ch.pop().expect("two columns");
             let y = ch.pop().expect("two columns");
             (y.rel <= 1e-12 && xp.rel <= 1e-12).then_some((y.x, y.wx, xp.x))

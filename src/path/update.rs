@@ -339,46 +339,67 @@ impl UpdatedLu {
         b: &[f64],
         row_bound: f64,
     ) -> Checked {
-        self.solve_checked_many(c, w, &[b], row_bound)
+        self.solve_checked_many(c, w, &[Rhs { b, guess: None }], row_bound)
             .pop()
             .expect("one column")
     }
 
-    /// `M_S⁻¹ b` for every `b` of `bs`, each with its relative residual
+    /// `M_S⁻¹ b` for every column, each with its relative residual
     /// `‖D(b − M_S x)‖∞ / (‖|D M_S||x|‖∞ + ‖D b‖∞)` (D: the row scaling to `r0` units;
-    /// `|D M_S|` bounded row-wise by `row_bound`, see [`row_bound`]) and `W x` (the
-    /// product the residual needs, which callers reuse). A column is refined once only
-    /// when its first residual is above [`REFINE_ABOVE`]: the columns together then cost
-    /// one pass over the base's factor and one over W.
+    /// `|D M_S|` bounded row-wise by `row_bound`, see [`row_bound`]) and the product with
+    /// W that the residual needs (which callers reuse). A column with a guess solves for
+    /// the correction only, from the guess's residual: its rounding is then relative to
+    /// that residual, not to b (an SMW solve of b itself can lose digits to cancellation
+    /// between the base's solution and the capacitance correction). A column is refined
+    /// once only when its first residual is above [`REFINE_ABOVE`]: the columns together
+    /// then cost one pass over the base's factor and one over W.
     pub fn solve_checked_many(
         &self,
         c: &PieceConstants<'_>,
         w: MatRef<'_, f64>,
-        bs: &[&[f64]],
+        cols: &[Rhs<'_>],
         row_bound: f64,
     ) -> Vec<Checked> {
-        let bs: Vec<Vec<f64>> = bs.iter().map(|b| scale_rhs(c, &self.classes, b)).collect();
+        let full: Vec<Vec<f64>> = cols
+            .iter()
+            .map(|col| scale_rhs(c, &self.classes, col.b))
+            .collect();
+        let bs: Vec<Vec<f64>> = cols
+            .iter()
+            .zip(&full)
+            .map(|(col, f)| match col.guess {
+                Some((_, r)) => scale_rhs(c, &self.classes, r),
+                None => f.clone(),
+            })
+            .collect();
         let c = &equilibrated(c);
-        let rel_of = |x: &[f64], r: &[f64], b: &[f64]| {
-            let bn = b.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let xn = x.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let rn = r.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let denom = row_bound * xn + bn;
-            let rel = if denom > 0.0 { rn / denom } else { rn };
-            if rel.is_finite() { rel } else { f64::INFINITY }
+        let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let finish = |k: usize, solved: Vec<f64>, r: Vec<f64>, wx: Vec<f64>| {
+            let x: Vec<f64> = match cols[k].guess {
+                Some((x0, _)) => x0.iter().zip(&solved).map(|(a, b)| a + b).collect(),
+                None => solved.clone(),
+            };
+            let denom = row_bound * inf(&x) + inf(&full[k]);
+            let rel = if denom > 0.0 {
+                inf(&r) / denom
+            } else {
+                inf(&r)
+            };
+            Checked {
+                rel: if rel.is_finite() { rel } else { f64::INFINITY },
+                x,
+                wx,
+                solved,
+                r,
+            }
         };
         let xs = self.solve(&bs);
         let checks = residuals(c, w, &self.classes, &xs, &bs);
         let mut out: Vec<Checked> = xs
             .into_iter()
             .zip(checks)
-            .zip(&bs)
-            .map(|((x, (r, wx)), b)| Checked {
-                rel: rel_of(&x, &r, b),
-                x,
-                wx,
-                r,
-            })
+            .enumerate()
+            .map(|(k, (x, (r, wx)))| finish(k, x, r, wx))
             .collect();
         let again: Vec<usize> = (0..out.len())
             .filter(|&k| out[k].rel > REFINE_ABOVE)
@@ -389,21 +410,24 @@ impl UpdatedLu {
             let xs: Vec<Vec<f64>> = again
                 .iter()
                 .zip(dxs)
-                .map(|(&k, dx)| out[k].x.iter().zip(&dx).map(|(a, d)| a + d).collect())
+                .map(|(&k, dx)| out[k].solved.iter().zip(&dx).map(|(a, d)| a + d).collect())
                 .collect();
             let b2: Vec<Vec<f64>> = again.iter().map(|&k| bs[k].clone()).collect();
             let checks = residuals(c, w, &self.classes, &xs, &b2);
             for ((&k, x), (r, wx)) in again.iter().zip(xs).zip(checks) {
-                out[k] = Checked {
-                    rel: rel_of(&x, &r, &bs[k]),
-                    x,
-                    wx,
-                    r,
-                };
+                out[k] = finish(k, x, r, wx);
             }
         }
         out
     }
+}
+
+/// A right-hand side of [`UpdatedLu::solve_checked_many`].
+pub(crate) struct Rhs<'a> {
+    /// b (the seed's row scaling, as [`PieceConstants::piece_rhs`] gives it).
+    pub b: &'a [f64],
+    /// A guess `x0` with its residual `b − M_S x0` (same scaling as b).
+    pub guess: Option<(&'a [f64], &'a [f64])>,
 }
 
 /// A solve with its check: see [`UpdatedLu::solve_checked`].
@@ -412,8 +436,10 @@ pub(crate) struct Checked {
     pub x: Vec<f64>,
     /// Its relative residual.
     pub rel: f64,
-    /// `W x`.
+    /// `W` times the solved part: `W x`, or for a column with a guess `W (x − x0)`.
     pub wx: Vec<f64>,
+    /// The solved part (x, or x − x0).
+    solved: Vec<f64>,
     /// The residual `D (b − M_S x)`.
     r: Vec<f64>,
 }
