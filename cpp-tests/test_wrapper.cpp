@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <iostream>
 #include <sstream>
@@ -453,6 +454,149 @@ int main(int argc, char **argv) {
         }
         report("a throwing solve gives FRICONT_ERR_SOLVE_CALLBACK", status == FRICONT_ERR_SOLVE_CALLBACK,
                std::to_string(status));
+    }
+
+    // 9. The monitor (reference: the C interface's events of the same path, unmonitored):
+    //    stopping after the third transition point keeps exactly the reference's first
+    //    events, and running again ends where the reference ends, with its events; the
+    //    monitor reads the path from inside the call.
+    {
+        long ref_transitions = ref.empty() ? 0 : ref.back().transition;
+        struct Seen {
+            double alpha;
+            int64_t transitions, first, end, events_inside;
+        };
+        std::vector<Seen> seen;
+        fricont::Path m = fricont::Path::affine(prob, c.f0, c.f1);
+        m.set_window(c.alpha_start, c.alpha_end);
+        m.set_monitor([&seen, &m](double a, int64_t tr, int64_t first, int64_t end) {
+            seen.push_back({a, tr, first, end, static_cast<int64_t>(m.events().size())});
+            return tr == 3;
+        });
+        m.start(c.alpha_start);
+        fricont::EndReason r = m.run();
+        report("monitor: stop after 3 transition points ends with Stopped",
+               r == fricont::EndReason::Stopped && m.end_reason() == fricont::EndReason::Stopped &&
+                   fricont::name(r) == "stopped",
+               fricont::name(r));
+        bool args_ok = seen.size() == 3 && ref_transitions >= 4;
+        for (std::size_t k = 0; args_ok && k < seen.size(); k++) {
+            const Seen &s = seen[k];
+            args_ok = s.transitions == static_cast<int64_t>(k + 1) &&
+                      s.first == (k ? seen[k - 1].end : 0) && s.end > s.first &&
+                      s.events_inside == s.end && s.end <= static_cast<int64_t>(ref.size()) &&
+                      s.alpha == ref[static_cast<std::size_t>(s.first)].alpha &&
+                      ref[static_cast<std::size_t>(s.end - 1)].transition == s.transitions;
+        }
+        report("monitor: alpha, transition count and new events of each call", args_ok,
+               std::to_string(seen.size()) + " calls");
+        std::vector<fricont::Event> got = m.events();
+        std::string d = seen.size() == 3 ? compare(got, ref, 0.0, same, got.size()) : "no stop";
+        report("monitor: events at the stop are the reference's first ones",
+               d.empty() && seen.size() == 3 && got.size() == static_cast<std::size_t>(seen[2].end),
+               d);
+        r = m.run();
+        got = m.events();
+        d = compare(got, ref, 0.0, same, ref.size());
+        report("monitor: running again ends at the window with the reference's events",
+               r == fricont::EndReason::Window && d.empty() && got.size() == ref.size() &&
+                   static_cast<long>(seen.size()) == ref_transitions,
+               fricont::name(r) + " " + d);
+    }
+
+    // 10. An exception thrown by the monitor comes out of run() (never crossing the
+    //     library), the path is stopped where it was, and it stays usable.
+    {
+        fricont::Path x = fricont::Path::affine(prob, c.f0, c.f1);
+        x.set_window(c.alpha_start, c.alpha_end);
+        x.set_monitor([](double, int64_t tr, int64_t, int64_t) -> bool {
+            if (tr == 2) throw std::out_of_range("the monitor gave up at 2");
+            return false;
+        });
+        x.start(c.alpha_start);
+        std::string caught;
+        try {
+            x.run();
+        } catch (const std::out_of_range &e) {
+            caught = e.what();
+        }
+        report("monitor exception rethrown by run()", caught == "the monitor gave up at 2", caught);
+        std::size_t upto = 0;
+        while (upto < ref.size() && ref[upto].transition <= 2) upto++;
+        std::vector<fricont::Event> got = x.events();
+        std::string d = compare(got, ref, 0.0, same, got.size());
+        report("monitor exception: stopped after transition point 2, events kept",
+               x.end_reason() == fricont::EndReason::Stopped && d.empty() && got.size() == upto,
+               fricont::name(x.end_reason()) + " " + d);
+        x.set_monitor(nullptr);
+        fricont::EndReason r = x.run();
+        got = x.events();
+        d = compare(got, ref, 0.0, same, ref.size());
+        report("monitor exception: the path runs on to the reference's end",
+               r == fricont::EndReason::Window && d.empty() && got.size() == ref.size(), d);
+    }
+
+    // 11. The largest alpha step: range and order errors; a narrow bump of a general load
+    //     (tests/core_oscillating.rs): one node, A = I, N = [1 0], T = [0 1], normal load
+    //     0.5 - 0.6 exp(-((a - a_b)/w)^2) opens the node where the exponential exceeds 5/6,
+    //     i.e. between a_b -+ w sqrt(ln 1.2); the default steps step over it, steps of at
+    //     most 1e-3 find both transitions there.
+    {
+        const double nan = std::numeric_limits<double>::quiet_NaN();
+        const double inf = std::numeric_limits<double>::infinity();
+        fricont::Path g = fricont::Path::affine(prob, c.f0, c.f1);
+        g.set_window(c.alpha_start, c.alpha_end);
+        bool all_range = true;
+        for (double h : {0.0, -1.0, nan, inf}) {
+            int32_t status = 0;
+            try {
+                g.set_max_alpha_step(h);
+            } catch (const fricont::Error &e) {
+                status = e.status();
+            }
+            all_range = all_range && status == FRICONT_ERR_RANGE;
+        }
+        report("max_alpha_step 0, -1, NaN, inf: FRICONT_ERR_RANGE", all_range);
+        g.set_max_alpha_step(0.1);
+        g.start(c.alpha_start);
+        int32_t status = 0;
+        try {
+            g.set_max_alpha_step(0.1);
+        } catch (const fricont::Error &e) {
+            status = e.status();
+        }
+        report("max_alpha_step after the start: FRICONT_ERR_ORDER", status == FRICONT_ERR_ORDER);
+
+        std::vector<int64_t> aptr{0, 1, 2}, aidx{0, 1}, ptr{0, 1}, nidx{0}, tidx{1};
+        std::vector<double> aval{1.0, 1.0}, one{1.0};
+        fricont::Problem node(fricont::CsrRef(2, 2, aptr, aidx, aval), fricont::Storage::Full,
+                              fricont::CsrRef(1, 2, ptr, nidx, one),
+                              fricont::CsrRef(1, 2, ptr, tidx, one));
+        node.set_friction(0.3);
+        const double ab = 21.5 / 64.0, w = 2e-3;
+        fricont::Path bump = fricont::Path::general(node, [ab, w](double a, double *out, std::size_t) {
+            out[0] = 0.5 - 0.6 * std::exp(-std::pow((a - ab) / w, 2));
+            out[1] = 0.0;
+        });
+        bump.set_window(-1.0, 1.0);
+        bump.set_max_alpha_step(1e-3);
+        bump.start(-1.0);
+        fricont::EndReason r = bump.run();
+        std::vector<fricont::Event> be = bump.events();
+        const double half = w * std::sqrt(std::log(1.2));
+        bool found = r == fricont::EndReason::Window && be.size() == 2;
+        std::ostringstream why;
+        why.precision(17);
+        why << be.size() << " events";
+        if (found) {
+            why << " at " << be[0].alpha << ", " << be[1].alpha;
+            found = std::fabs(be[0].alpha - (ab - half)) <= 1e-10 &&
+                    std::fabs(be[1].alpha - (ab + half)) <= 1e-10 &&
+                    be[0].from == fricont::Class::Stick && be[0].to == fricont::Class::Open &&
+                    be[1].from == fricont::Class::Open && be[1].to == fricont::Class::Stick;
+        }
+        report("max_alpha_step 1e-3: both transitions of a narrow bump at the analytic alpha",
+               found, why.str());
     }
 
     std::cout << "cpp-tests: " << failures << " failed check(s)\n";

@@ -24,6 +24,10 @@
 !>   `fricont_load_fn` / `fricont_weights_fn`; they must return a nonzero code instead
 !>   of stopping the program. `user_data` (from `c_loc` of a `target` variable) reaches
 !>   them unchanged.
+!> * A progress monitor (`path%set_monitor`) is a Fortran function of the interface
+!>   `fricont_monitor_fn` (no bind(C) needed: the module calls it through its own
+!>   trampoline, with 1-based event numbers); returning .true. stops `run` with the end
+!>   reason FRICONT_END_STOPPED, and the next `run` continues from there.
 !>
 !> Signs and units: lambda_n <= 0 is compressive; (N u)_i <= g_i is non-penetration;
 !> forces are in the units of A u.
@@ -75,8 +79,9 @@ module fricont
     integer, parameter, public :: FRICONT_END_CLOSED_LOOP = 3
     integer, parameter, public :: FRICONT_END_BIFURCATION = 4
     integer, parameter, public :: FRICONT_END_FAILED = 5
+    integer, parameter, public :: FRICONT_END_STOPPED = 6
 
-    public :: fricont_load_fn, fricont_weights_fn, fricont_solve_fn
+    public :: fricont_load_fn, fricont_weights_fn, fricont_solve_fn, fricont_monitor_fn
     public :: fricont_class_name, fricont_end_reason_name, fricont_status_name, fricont_version
 
     !> The error argument: `status` (a negative fricont_status, or FRICONT_OK) and the
@@ -154,6 +159,8 @@ module fricont
         procedure :: set_window => path_set_window
         procedure :: set_max_steps => path_set_max_steps
         procedure :: set_zero_tol => path_set_zero_tol
+        procedure :: set_max_alpha_step => path_set_max_alpha_step
+        procedure :: set_monitor => path_set_monitor
         procedure :: start => path_start
         procedure :: step => path_step
         procedure :: run => path_run
@@ -244,7 +251,28 @@ module fricont
             real(c_double), intent(inout) :: x(ldx, ncols)
             integer(c_int) :: code
         end function fricont_solve_fn
+        !> A progress monitor (see path%set_monitor), called by path%run after each
+        !> transition point: `alpha` of the point, `transitions` traced so far, the new
+        !> events first_event..last_event (1-based, for path%event; one per node that
+        !> changed class), `user_data` as given to set_monitor. Return .false. to go on,
+        !> .true. to stop the path (FRICONT_END_STOPPED). It may read the path (event,
+        !> event_state, ...) but must not free it, nor stop the program.
+        function fricont_monitor_fn(alpha, transitions, first_event, last_event, user_data) &
+            result(stop_path)
+            import :: real64, int64, c_ptr
+            real(real64), intent(in) :: alpha
+            integer(int64), intent(in) :: transitions, first_event, last_event
+            type(c_ptr), intent(in) :: user_data
+            logical :: stop_path
+        end function fricont_monitor_fn
     end interface
+
+    ! The monitor and its user data, allocated by set_monitor and owned by the library
+    ! (deallocated by monitor_free when replaced, removed or the path is freed).
+    type :: monitor_box
+        procedure(fricont_monitor_fn), pointer, nopass :: f => null()
+        type(c_ptr) :: user_data = c_null_ptr
+    end type monitor_box
 
     ! ---- The C functions (private) -------------------------------------------------------
     interface
@@ -377,6 +405,19 @@ module fricont
             type(c_ptr), value :: h
             real(c_double), value :: t
             integer(c_int32_t) :: c_path_set_zero_tol
+        end function
+        function c_path_set_max_alpha_step(h, s) bind(C, name="fricont_path_set_max_alpha_step")
+            import :: c_ptr, c_int32_t, c_double
+            type(c_ptr), value :: h
+            real(c_double), value :: s
+            integer(c_int32_t) :: c_path_set_max_alpha_step
+        end function
+        function c_path_set_monitor(h, f, user_data, free_fn) &
+            bind(C, name="fricont_path_set_monitor")
+            import :: c_ptr, c_int32_t, c_funptr
+            type(c_ptr), value :: h, user_data
+            type(c_funptr), value :: f, free_fn
+            integer(c_int32_t) :: c_path_set_monitor
         end function
         function c_path_start(h, alpha, guess, len) bind(C, name="fricont_path_start")
             import :: c_ptr, c_int32_t, c_int64_t, c_double
@@ -583,7 +624,7 @@ contains
     end function fricont_class_name
 
     !> Name of an end reason: "none", "window", "max_steps", "closed_loop",
-    !> "bifurcation", "failed".
+    !> "bifurcation", "failed", "stopped".
     function fricont_end_reason_name(code) result(s)
         integer, intent(in) :: code
         character(len=:), allocatable :: s
@@ -594,6 +635,7 @@ contains
         case (FRICONT_END_CLOSED_LOOP); s = 'closed_loop'
         case (FRICONT_END_BIFURCATION); s = 'bifurcation'
         case (FRICONT_END_FAILED); s = 'failed'
+        case (FRICONT_END_STOPPED); s = 'stopped'
         case default; s = 'unknown'
         end select
     end function fricont_end_reason_name
@@ -984,6 +1026,68 @@ contains
         call handle(c_path_set_zero_tol(self%h, tol), err, 'fricont_path%set_zero_tol')
     end subroutine path_set_zero_tol
 
+    !> The largest alpha step (alpha units) of the step control of a nonlinear load
+    !> (create_basis, create_general); default 1/8 of the window. A load feature narrower
+    !> than the steps (a bump, a fast oscillation) can be stepped over; a largest step no
+    !> longer than the narrowest feature cannot miss it. No effect on an affine load.
+    !> Before start only. FRICONT_ERR_RANGE when not finite or <= 0, FRICONT_ERR_ORDER
+    !> after the start.
+    subroutine path_set_max_alpha_step(self, h, err)
+        class(fricont_path), intent(inout) :: self
+        real(real64), intent(in) :: h
+        type(fricont_error), intent(out), optional :: err
+        call handle(c_path_set_max_alpha_step(self%h, h), err, 'fricont_path%set_max_alpha_step')
+    end subroutine path_set_max_alpha_step
+
+    !> Sets the progress monitor that `run` calls after each transition point (replacing
+    !> an earlier one), or removes it when `monitor` is absent. `monitor` has the interface
+    !> fricont_monitor_fn (a module procedure, or any procedure that outlives the path);
+    !> `user_data` (c_loc of a target variable that outlives the path, for instance the
+    !> path itself) is passed to it unchanged. When it returns .true., `run` ends with the
+    !> end reason FRICONT_END_STOPPED, keeping everything traced; the next `run` or `step`
+    !> continues from there. `step` does not call it.
+    subroutine path_set_monitor(self, monitor, user_data, err)
+        class(fricont_path), intent(inout) :: self
+        procedure(fricont_monitor_fn), optional :: monitor
+        type(c_ptr), intent(in), optional :: user_data
+        type(fricont_error), intent(out), optional :: err
+        type(monitor_box), pointer :: box
+        if (.not. present(monitor)) then
+            call handle(c_path_set_monitor(self%h, c_null_funptr, c_null_ptr, c_null_funptr), &
+                        err, 'fricont_path%set_monitor')
+            return
+        end if
+        allocate (box)
+        box%f => monitor
+        if (present(user_data)) box%user_data = user_data
+        ! The library owns box from here: it calls monitor_free exactly once (also when
+        ! this call fails).
+        call handle(c_path_set_monitor(self%h, c_funloc(monitor_trampoline), c_loc(box), &
+                                       c_funloc(monitor_free)), err, 'fricont_path%set_monitor')
+    end subroutine path_set_monitor
+
+    ! The C monitor: calls the Fortran one with 1-based event numbers.
+    function monitor_trampoline(alpha, transitions, first_event, end_event, box_ptr) &
+        bind(C) result(code)
+        real(c_double), value :: alpha
+        integer(c_int64_t), value :: transitions, first_event, end_event
+        type(c_ptr), value :: box_ptr
+        integer(c_int32_t) :: code
+        type(monitor_box), pointer :: box
+        call c_f_pointer(box_ptr, box)
+        code = 0
+        if (box%f(alpha, int(transitions, int64), int(first_event + 1, int64), &
+                  int(end_event, int64), box%user_data)) code = 1
+    end function monitor_trampoline
+
+    ! The finalizer of a monitor_box (called by the library).
+    subroutine monitor_free(box_ptr) bind(C)
+        type(c_ptr), value :: box_ptr
+        type(monitor_box), pointer :: box
+        call c_f_pointer(box_ptr, box)
+        deallocate (box)
+    end subroutine monitor_free
+
     !> Starts (or restarts) at alpha, from zero contact forces or from `guess` =
     !> (lambda_n(1:p), lambda_t(1:p)).
     subroutine path_start(self, alpha, guess, err)
@@ -1014,7 +1118,9 @@ contains
         call handle(st, err, 'fricont_path%step')
     end subroutine path_step
 
-    !> Steps until the path ends; `reason` receives the end reason (FRICONT_END_*).
+    !> Steps until the path ends, calling the monitor (set_monitor), if any, after each
+    !> transition point; `reason` receives the end reason (FRICONT_END_*;
+    !> FRICONT_END_STOPPED when the monitor stopped it).
     subroutine path_run(self, reason, err)
         class(fricont_path), intent(inout) :: self
         integer, intent(out), optional :: reason

@@ -3,7 +3,8 @@
 # (fortran/fricont.f90) and the example fortran/examples/trace_sample.f90 trace the
 # sample problem; their events must equal those of the C interface
 # (tests-install/trace_case.c), for the affine load and for a load computed by a Fortran
-# bind(C) callback; fortran/tests/test_api.f90 checks the rest of the interface.
+# bind(C) callback; fortran/tests/test_api.f90 checks the rest of the interface (also
+# under valgrind).
 source "$(dirname "$0")/../tests-install/common.sh"
 
 need_cmd gfortran gfortran || { fail "gfortran available"; finish; }
@@ -42,6 +43,11 @@ if [ -x test_api ]; then
     PASSED=$((PASSED + $(grep -c '^ok ' api.txt)))
     FAILED=$((FAILED + $(grep -c '^FAIL ' api.txt)))
     [ "$rc" -eq 0 ] || [ "$(grep -c '^FAIL ' api.txt)" -gt 0 ] || fail "test_api exited with $rc"
+    if command -v valgrind >/dev/null 2>&1; then
+        run_check "test_api under valgrind (monitors and callbacks: no invalid access, no definite leak)" \
+            valgrind -q --leak-check=full --errors-for-leak-kinds=definite --error-exitcode=99 \
+            ./test_api "$CASE"
+    fi
 fi
 if [ -x test_stop ]; then
     run_check "no err argument: a failing call stops with the library's message" \

@@ -7,7 +7,9 @@
 // * A load given as a C++ callable is called through a `noexcept` trampoline: an
 //   exception it throws is caught before it could reach the library, the callback returns
 //   a nonzero code (the library ends the step cleanly), and the wrapper rethrows the
-//   original exception once the C call has returned.
+//   original exception once the C call has returned. A progress monitor
+//   (`Path::set_monitor`) is wrapped the same way: an exception it throws stops the path
+//   (`EndReason::Stopped`) and is rethrown by `Path::run`.
 // * Indices are those of the C interface: 0-based nodes, events and pieces; CSR input
 //   takes an `index_base` of 0 or 1.
 //
@@ -22,6 +24,7 @@
 #include <cstdint>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -76,9 +79,11 @@ enum class EndReason : int32_t {
     ClosedLoop = FRICONT_END_CLOSED_LOOP,
     Bifurcation = FRICONT_END_BIFURCATION,
     Failed = FRICONT_END_FAILED,
+    /// The monitor (`Path::set_monitor`) stopped the path; `run`/`step` continue from there.
+    Stopped = FRICONT_END_STOPPED,
 };
 
-/// "none", "window", "max_steps", "closed_loop", "bifurcation" or "failed".
+/// "none", "window", "max_steps", "closed_loop", "bifurcation", "failed" or "stopped".
 inline std::string name(EndReason r) {
     switch (r) {
     case EndReason::None: return "none";
@@ -87,6 +92,7 @@ inline std::string name(EndReason r) {
     case EndReason::ClosedLoop: return "closed_loop";
     case EndReason::Bifurcation: return "bifurcation";
     case EndReason::Failed: return "failed";
+    case EndReason::Stopped: return "stopped";
     }
     return "unknown";
 }
@@ -228,6 +234,31 @@ extern "C" inline int32_t fricont_cxx_dload_trampoline(double alpha, double *out
 
 extern "C" inline void fricont_cxx_free_context(void *ud) {
     delete static_cast<LoadContext *>(ud);
+}
+
+/// A monitor's context, owned by the library (freed through `fricont_cxx_free_monitor`
+/// when the monitor is replaced or removed, or the path freed). `pending` is shared with
+/// the `Path`, so that an exception is kept even if the monitor replaced itself.
+struct MonitorContext {
+    std::function<bool(double, int64_t, int64_t, int64_t)> f;
+    std::shared_ptr<std::exception_ptr> pending;
+};
+
+extern "C" inline int32_t fricont_cxx_monitor_trampoline(double alpha, int64_t transitions,
+                                                         int64_t first_event, int64_t end_event,
+                                                         void *ud) {
+    auto *ctx = static_cast<MonitorContext *>(ud);
+    try {
+        return ctx->f(alpha, transitions, first_event, end_event) ? 1 : 0;
+    } catch (...) {
+        // Never let an exception reach the library: keep it and stop the path.
+        if (!*ctx->pending) *ctx->pending = std::current_exception();
+        return 1;
+    }
+}
+
+extern "C" inline void fricont_cxx_free_monitor(void *ud) {
+    delete static_cast<MonitorContext *>(ud);
 }
 
 }  // namespace detail
@@ -397,13 +428,14 @@ public:
     Path(const Path &) = delete;
     Path &operator=(const Path &) = delete;
     Path(Path &&o) noexcept
-        : h_(std::exchange(o.h_, nullptr)), ctx_(std::exchange(o.ctx_, nullptr)), n_(o.n_),
-          p_(o.p_) {}
+        : h_(std::exchange(o.h_, nullptr)), ctx_(std::exchange(o.ctx_, nullptr)),
+          pending_(std::move(o.pending_)), n_(o.n_), p_(o.p_) {}
     Path &operator=(Path &&o) noexcept {
         if (this != &o) {
             fricont_path_free(h_);
             h_ = std::exchange(o.h_, nullptr);
             ctx_ = std::exchange(o.ctx_, nullptr);
+            pending_ = std::move(o.pending_);
             n_ = o.n_;
             p_ = o.p_;
         }
@@ -423,6 +455,39 @@ public:
     void set_max_steps(int64_t max_steps) { check(fricont_path_set_max_steps(h_, max_steps)); }
     /// The relative zero tolerance of guards (default 1e-11).
     void set_zero_tol(double tol) { check(fricont_path_set_zero_tol(h_, tol)); }
+    /// The largest α step (α units) of the step control of a nonlinear load (`general`):
+    /// default 1/8 of the window. A load feature narrower than the steps (a bump, a fast
+    /// oscillation) can be stepped over; a largest step no longer than the narrowest
+    /// feature cannot miss it (see `fricont_path_set_max_alpha_step`). No effect on an
+    /// affine load. Before `start` only. Throws `Error` (FRICONT_ERR_RANGE when not finite
+    /// or <= 0, FRICONT_ERR_ORDER after the start).
+    void set_max_alpha_step(double h) { check(fricont_path_set_max_alpha_step(h_, h)); }
+
+    /// A progress monitor: `monitor(alpha, transitions, first_event, end_event)` is called
+    /// by `run` after each transition point, with its α, the number of transition points
+    /// traced so far and the new events `first_event .. end_event - 1` (0-based indices
+    /// into `events()`). Return `false` to go on, `true` to stop: `run` then returns
+    /// `EndReason::Stopped`, keeping everything traced, and the next `run` or `step`
+    /// continues from there. An exception the monitor throws also stops the path and is
+    /// rethrown by `run` (never crossing the library); the path stays usable.
+    using MonitorFn = std::function<bool(double alpha, int64_t transitions, int64_t first_event,
+                                         int64_t end_event)>;
+
+    /// Sets the monitor (replacing any earlier one), or removes it when `monitor` is empty.
+    /// It may read this path (`events()`, `event_state`, ...) from inside the call; it must
+    /// not destroy or move it. Called by `run` only, not by `step`.
+    void set_monitor(MonitorFn monitor) {
+        if (!monitor) {
+            check(fricont_path_set_monitor(h_, nullptr, nullptr, nullptr));
+            return;
+        }
+        if (!pending_) pending_ = std::make_shared<std::exception_ptr>();
+        auto *ctx = new detail::MonitorContext{std::move(monitor), pending_};
+        // The library owns ctx from here: it calls fricont_cxx_free_monitor exactly once
+        // (also when this call fails).
+        check(fricont_path_set_monitor(h_, detail::fricont_cxx_monitor_trampoline, ctx,
+                                       detail::fricont_cxx_free_monitor));
+    }
 
     /// Starts at α from zero contact forces, or from `guess` = (λν, λt) (2p values).
     void start(double alpha, const std::vector<double> &guess = {}) {
@@ -431,7 +496,9 @@ public:
     }
     /// Advances to the next transition point or to the end.
     Outcome step() { return static_cast<Outcome>(check(fricont_path_step(h_))); }
-    /// Steps until the end; returns why it ended.
+    /// Steps until the end, calling the monitor (if set) after each transition point;
+    /// returns why it ended (`EndReason::Stopped` when the monitor asked to stop).
+    /// Rethrows an exception of a load callback or of the monitor.
     EndReason run() {
         check(fricont_path_run(h_));
         return end_reason();
@@ -544,11 +611,15 @@ private:
         return s;
     }
 
-    // Rethrows an exception a load callback raised during the call that just returned,
-    // else throws `Error` with the handle's message for a negative status.
+    // Rethrows an exception a load callback or the monitor raised during the call that
+    // just returned, else throws `Error` with the handle's message for a negative status.
     int32_t check(int32_t st) const {
         if (ctx_ && ctx_->pending) {
             std::exception_ptr e = std::exchange(ctx_->pending, nullptr);
+            std::rethrow_exception(e);
+        }
+        if (pending_ && *pending_) {
+            std::exception_ptr e = std::exchange(*pending_, nullptr);
             std::rethrow_exception(e);
         }
         if (st < 0) {
@@ -562,6 +633,8 @@ private:
 
     fricont_path *h_ = nullptr;
     detail::LoadContext *ctx_ = nullptr;  // owned by the library (freed with the path)
+    // an exception of the monitor, shared with its context (see set_monitor)
+    std::shared_ptr<std::exception_ptr> pending_;
     int64_t n_ = 0;
     int64_t p_ = 0;
 };

@@ -163,7 +163,7 @@ fn finite_element_sine_shear_finds_every_transition() {
 /// One node as above under the normal load `c(α) = 0.5 − 0.6 exp(−((α − α_b)/w)²)`: a
 /// bump of width w = 2e-3 at α_b = 21.5/64 (half-way between two points of the dyadic
 /// grid of 1/64 on which the default step control evaluates here) opens the node for a stretch of α of width
-/// 2 w √ln 6 ≈ 5.4e-3 around α_b (transitions where the exponential equals 5/6). The
+/// 2 w √ln 1.2 ≈ 1.7e-3 around α_b (transitions where the exponential equals 5/6). The
 /// step control of the default (steps up to 1/8 of the window, each checked at its
 /// midpoint) evaluates the load nowhere near the bump, sees a flat load and misses it:
 /// the documented limit. `max_alpha_step` = 1e-3 (below the stretch) finds both

@@ -1,17 +1,66 @@
 !> Tests of the fricont Fortran module beyond the traced events (which run.sh compares
 !> with the C interface): the err argument, 0- and 1-based CSR with 32- and 64-bit
 !> indices, a failing Fortran callback, the basis load, solutions_at checked against the
-!> equations evaluated here. Prints "ok NAME" / "FAIL NAME: why"; exits 1 on a failure.
+!> equations evaluated here, the monitor (stop and resume, against the unmonitored run)
+!> and the largest alpha step (a narrow bump found at its analytic alpha).
+!> Prints "ok NAME" / "FAIL NAME: why"; exits 1 on a failure.
 module api_callbacks
     use, intrinsic :: iso_c_binding, only: c_double, c_int64_t, c_int32_t, c_ptr, &
         c_f_pointer
-    use, intrinsic :: iso_fortran_env, only: real64
+    use, intrinsic :: iso_fortran_env, only: real64, int64
+    use fricont, only: fricont_path, fricont_event
     implicit none
     type :: stop_load
         real(real64), allocatable :: f0(:), f1(:)
         real(real64) :: stop_at = 0
     end type stop_load
+    !> What the monitor saw: calls, wrong arguments or reads, the last event number.
+    type :: monitor_log
+        type(fricont_path), pointer :: path => null()
+        integer(int64) :: stop_at = 3
+        integer :: calls = 0, bad = 0
+        integer(int64) :: last_transitions = 0, last_event = 0
+    end type monitor_log
 contains
+    !> Checks its arguments against the path read from inside the call (the events
+    !> first_event..last_event are new, at alpha, of transition point `transitions`) and
+    !> stops at transition point stop_at.
+    function logging_monitor(alpha, transitions, first_event, last_event, user_data) &
+        result(stop_path)
+        real(real64), intent(in) :: alpha
+        integer(int64), intent(in) :: transitions, first_event, last_event
+        type(c_ptr), intent(in) :: user_data
+        logical :: stop_path
+        type(monitor_log), pointer :: log
+        type(fricont_event) :: e
+        integer(int64) :: k
+        call c_f_pointer(user_data, log)
+        log%calls = log%calls + 1
+        if (transitions /= log%last_transitions + 1 .or. first_event /= log%last_event + 1 &
+            .or. last_event < first_event) log%bad = log%bad + 1
+        if (log%path%event_count() /= last_event) log%bad = log%bad + 1
+        do k = first_event, last_event
+            e = log%path%event(int(k))
+            if (e%alpha /= alpha .or. e%transition /= transitions .or. e%index /= k) &
+                log%bad = log%bad + 1
+        end do
+        log%last_transitions = transitions
+        log%last_event = last_event
+        stop_path = transitions == log%stop_at
+    end function logging_monitor
+
+    !> A narrow bump of the normal load: (0.5 - 0.6 exp(-((alpha - 21.5/64)/2e-3)^2), 0).
+    function bump_load(alpha, f, n, user_data) bind(C) result(code)
+        real(c_double), value :: alpha
+        integer(c_int64_t), value :: n
+        real(c_double), intent(out) :: f(n)
+        type(c_ptr), value :: user_data
+        integer(c_int32_t) :: code
+        f = 0
+        f(1) = 0.5_c_double - 0.6_c_double*exp(-((alpha - 21.5_c_double/64)/2e-3_c_double)**2)
+        code = 0
+    end function bump_load
+
     !> f0 + alpha f1, but refuses (code 7) past stop_at.
     function refusing_load(alpha, f, n, user_data) bind(C) result(code)
         real(c_double), value :: alpha
@@ -54,6 +103,7 @@ end module api_callbacks
 
 program test_api
     use, intrinsic :: iso_c_binding, only: c_loc
+    use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan, ieee_positive_inf
     use, intrinsic :: iso_fortran_env, only: real64, int64
     use fricont
     use case_reader, only: case_data, csr_matrix, read_case
@@ -265,6 +315,83 @@ contains
                          all(abs(sinh(evb%alpha) - ev%alpha) <= &
                              1e-9_real64*max(1.0_real64, abs(ev%alpha)))
         call check('basis load: events at asinh of the affine ones', same)
+
+        ! The monitor: stopping after the third transition point keeps the unmonitored
+        ! run's first events; running again ends at the window with all of its events.
+        block
+            type(fricont_path), target :: mp
+            type(monitor_log), target :: log
+            type(fricont_event), allocatable :: em(:)
+            call mp%create_affine(prob, c%f0, c%f1)
+            call mp%set_window(c%alpha_start, c%alpha_end)
+            log%path => mp
+            call mp%set_monitor(logging_monitor, c_loc(log))
+            call mp%start(c%alpha_start)
+            call mp%run(reason)
+            em = mp%events()
+            k = mp%end_reason()
+            call check('monitor: stops after 3 transition points (FRICONT_END_STOPPED)', &
+                       reason == FRICONT_END_STOPPED .and. k == FRICONT_END_STOPPED .and. &
+                       log%calls == 3 .and. fricont_end_reason_name(reason) == 'stopped', &
+                       fricont_end_reason_name(reason))
+            same = size(em) == log%last_event .and. size(em) < size(ev)
+            if (same) same = all(em%alpha == ev(1:size(em))%alpha) .and. &
+                             all(em%node == ev(1:size(em))%node) .and. &
+                             em(size(em))%transition == 3 .and. ev(size(em) + 1)%transition == 4
+            call check('monitor: the events at the stop are the unmonitored run''s first ones', same)
+            call mp%run(reason)
+            em = mp%events()
+            same = size(em) == size(ev)
+            if (same) same = all(em%alpha == ev%alpha) .and. all(em%node == ev%node) .and. &
+                             all(em%to == ev%to)
+            call check('monitor: running again ends at the window with the same events', &
+                       same .and. reason == FRICONT_END_WINDOW .and. &
+                       log%calls == ev(size(ev))%transition)
+            call check('monitor: arguments and reads of the path inside the call', log%bad == 0)
+            call mp%set_monitor()
+        end block
+
+        ! The largest alpha step: range errors, and a narrow bump of a general load on one
+        ! node (A = I, N = [1 0], T = [0 1]; tests/core_oscillating.rs) that opens the node
+        ! between 21.5/64 -+ 2e-3 sqrt(ln 1.2): steps of at most 1e-3 find both transitions.
+        block
+            type(fricont_problem) :: one
+            type(fricont_path) :: bump
+            type(fricont_event), allocatable :: eb(:)
+            real(real64) :: ab, half
+            call bump%create_affine(prob, c%f0, c%f1)
+            call bump%set_max_alpha_step(0.0_real64, err=err)
+            same = err%status == FRICONT_ERR_RANGE
+            call bump%set_max_alpha_step(-1.0_real64, err=err)
+            same = same .and. err%status == FRICONT_ERR_RANGE
+            call bump%set_max_alpha_step(ieee_value(1.0_real64, ieee_quiet_nan), err=err)
+            same = same .and. err%status == FRICONT_ERR_RANGE
+            call bump%set_max_alpha_step(ieee_value(1.0_real64, ieee_positive_inf), err=err)
+            call check('max_alpha_step 0, -1, NaN, inf: FRICONT_ERR_RANGE', &
+                       same .and. err%status == FRICONT_ERR_RANGE, err%message)
+            call one%create([1, 2, 3], [1, 2], [1.0_real64, 1.0_real64], [1, 2], [1], &
+                            [1.0_real64], [1, 2], [2], [1.0_real64])
+            call one%set_friction(0.3_real64)
+            call bump%create_general(one, bump_load)
+            call bump%set_window(-1.0_real64, 1.0_real64)
+            call bump%set_max_alpha_step(1e-3_real64)
+            call bump%start(-1.0_real64)
+            call bump%set_max_alpha_step(1e-3_real64, err=err)
+            call check('max_alpha_step after the start: FRICONT_ERR_ORDER', &
+                       err%status == FRICONT_ERR_ORDER, err%message)
+            call bump%run(reason)
+            eb = bump%events()
+            ab = 21.5_real64/64
+            half = 2e-3_real64*sqrt(log(1.2_real64))
+            same = size(eb) == 2 .and. reason == FRICONT_END_WINDOW
+            if (same) same = abs(eb(1)%alpha - (ab - half)) <= 1e-10_real64 .and. &
+                             abs(eb(2)%alpha - (ab + half)) <= 1e-10_real64 .and. &
+                             eb(1)%from == FRICONT_STICK .and. eb(1)%to == FRICONT_OPEN .and. &
+                             eb(2)%from == FRICONT_OPEN .and. eb(2)%to == FRICONT_STICK
+            write (buf, '(i0,a)') size(eb), ' events'
+            call check('max_alpha_step 1e-3: both transitions of a narrow bump at the analytic alpha', &
+                       same, buf)
+        end block
 
         ! Misuse through err: starting outside the window, a wrong guess length.
         call path%start(c%alpha_end + 10, err=err)

@@ -174,11 +174,17 @@ class Path:
 
     ``events``, ``pieces`` and ``end_reason`` describe what was traced; ``event_state(k)``
     gives the full state at event k (one back-solve for u), ``solutions_at(alpha)`` every
-    traced solution at alpha, ``to_dict()`` the JSON report of the CLI (1-based numbers).
+    traced solution at alpha, ``to_dict()`` the JSON report of the CLI (1-based numbers),
+    ``resume()`` continues a path that its monitor stopped.
     """
 
     def __init__(self, core: Any):
         self._core = core
+        self._refresh()
+
+    def _refresh(self) -> None:
+        """Reads what the core path holds now."""
+        core = self._core
         self.events: list = [
             Event(i, a, node, fc, tc, fold, bif, ln, lt, tr)
             for i, (a, node, fc, tc, fold, bif, ln, lt, tr) in enumerate(core.events())
@@ -198,14 +204,31 @@ class Path:
         ]
         reason, message = core.end_reason()
         #: Why the path ended: "window", "max_steps", "closed_loop", "bifurcation",
-        #: "failed", or "stopped" (by the monitor).
-        self.end_reason: str = reason if reason is not None else "stopped"
+        #: "failed", "stopped" (by the monitor: :meth:`resume` continues), or "none" when
+        #: it never started (the start solve failed).
+        self.end_reason: str = reason if reason is not None else "none"
         #: The failure message when ``end_reason == "failed"``.
         self.end_message: Optional[str] = message
         self.start: Optional[dict] = core.start_state()
 
     def __repr__(self) -> str:
         return f"<fricont.Path: {len(self.events)} events, end {self.end_reason!r}>"
+
+    def resume(self, monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None) -> "Path":
+        """Continues a path that its monitor stopped (``end_reason == "stopped"``) from
+        where it stopped, until it ends again, and returns it (``events``, ``pieces``,
+        ``end_reason`` updated; the events equal those of a run that was never stopped).
+        ``monitor`` is called as in :meth:`Problem.trace` (the one given there is not kept:
+        pass it again to keep monitoring); the GIL is released meanwhile. A path that ended
+        for another reason is left as it is.
+
+        Raises: as :meth:`Problem.trace` (the exception carries this path as ``err.path``);
+        :class:`UsageError` when called from inside the path's own monitor.
+        """
+        self._core.resume(monitor)
+        self._refresh()
+        _raise_pending(self)
+        return self
 
     def event_state(self, k: int) -> dict:
         """The full state at event k (0-based): ``u`` (n), ``lambda_n``, ``lambda_t`` (p),
@@ -307,6 +330,7 @@ class Problem:
         dload: Optional[Callable[[float], Any]] = None,
         n: Optional[int] = None,
         monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None,
+        max_alpha_step: Optional[float] = None,
     ) -> Path:
         """Traces the solution path over ``window = (alpha_start, alpha_end)``.
 
@@ -317,47 +341,65 @@ class Problem:
         ``alpha_start`` (default ``window[0]``) is where the fixed-alpha solve starts the
         path; it then goes toward ``window[1]``, through folds, until alpha leaves the
         window. ``max_steps`` bounds the number of transition points (default 10 000).
+
         ``monitor(alpha, transitions, (first_event, end_event))`` is called after each
-        transition point; a true return value stops the path (``end_reason == "stopped"``).
+        transition point with its alpha, the number of transition points so far and the
+        range of the new events (0-based indices into ``path.events``). A true return
+        value stops the path cleanly: ``end_reason == "stopped"`` (also in ``to_dict()``),
+        everything traced is kept, and :meth:`Path.resume` continues from there.
+
+        ``max_alpha_step`` (alpha units; default 1/8 of the window) bounds the steps of the
+        step control of a general load: a feature of ``load`` narrower than the steps (a
+        bump, a fast oscillation) can be stepped over unseen, a step no longer than the
+        narrowest feature cannot miss it. No effect on an affine load (its pieces are
+        followed exactly). ValueError when it is not finite or <= 0.
 
         The GIL is released while tracing (re-acquired only to call ``load``, ``dload`` or
         ``monitor``), so threads can trace different problems at once.
 
         Raises: ValueError for bad arguments; SolveError when the start solve fails; an
         exception raised inside ``load``/``dload``/``monitor`` stops the path and is
-        re-raised with what was traced kept on it as ``err.path`` (a :class:`Path`); other
-        numerical failures raise NumericalError, also with ``err.path``.
+        re-raised with what was traced kept on it as ``err.path`` (a :class:`Path`; after
+        an exception of ``monitor`` it is stopped, ``end_reason == "stopped"``, and can be
+        resumed); other numerical failures raise NumericalError, also with ``err.path``.
         """
         if len(window) != 2:
             raise ValueError("window must be (alpha_start, alpha_end)")
         win = (float(window[0]), float(window[1]))
         a0 = None if alpha_start is None else float(alpha_start)
         ms = None if max_steps is None else int(max_steps)
+        h = None if max_alpha_step is None else float(max_alpha_step)
         if load is not None:
             if f0 is not None or f1 is not None:
                 raise ValueError("give either f0 and f1 (affine load) or load=, not both")
             core = self._core.trace_general(
-                load, dload, int(n) if n is not None else self.n, win, a0, ms, monitor
+                load, dload, int(n) if n is not None else self.n, win, a0, ms, h, monitor
             )
         else:
             if f0 is None or f1 is None:
                 raise ValueError("an affine load needs f0 and f1 (or give load=)")
             try:
                 core = self._core.trace_affine(
-                    _vector("f0", f0), _vector("f1", f1), win, a0, ms, monitor
+                    _vector("f0", f0), _vector("f1", f1), win, a0, ms, h, monitor
                 )
             except Exception as err:  # noqa: BLE001
                 raise _reraise(err) from None
-        err = core.take_error()
         path = Path(core)
-        if err is not None:
-            err = _reraise(err)
-            try:
-                err.path = path
-            except AttributeError:
-                pass
-            raise err
+        _raise_pending(path)
         return path
+
+
+def _raise_pending(path: Path) -> None:
+    """Raises the exception that ended the last run of ``path``, if any, with the path
+    attached as ``err.path``."""
+    err = path._core.take_error()
+    if err is not None:
+        err = _reraise(err)
+        try:
+            err.path = path
+        except AttributeError:
+            pass
+        raise err
 
 
 def read_case(directory) -> dict:

@@ -5,7 +5,9 @@
 //! numpy and the Rust API of `fricont`, releases the GIL while the library computes, and
 //! maps the library's errors to Python exceptions. Node indices are 0-based here.
 
-use std::sync::{Arc, Mutex};
+use std::ops::ControlFlow;
+use std::sync::{Arc, Mutex, MutexGuard, TryLockError};
+use std::thread::ThreadId;
 
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
 use pyo3::create_exception;
@@ -15,9 +17,7 @@ use pyo3::types::{PyDict, PyList};
 
 use fricont::load::LoadFailure;
 use fricont::path::State;
-use fricont::{
-    Class, CsrMatrix, EndReason, Load, PathOptions, ProblemBuilder, StepOutcome, Storage,
-};
+use fricont::{Class, CsrMatrix, EndReason, Load, PathOptions, ProblemBuilder, Storage};
 use fricont_exchange::io::CaseData;
 use fricont_exchange::report::{PathReport, Timing};
 
@@ -207,7 +207,7 @@ impl Problem {
 
     /// Traces an affine load f0 + α f1 (see `fricont.Problem.trace`).
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (f0, f1, window, alpha_start, max_steps, monitor))]
+    #[pyo3(signature = (f0, f1, window, alpha_start, max_steps, max_alpha_step, monitor))]
     fn trace_affine(
         &self,
         py: Python<'_>,
@@ -216,17 +216,19 @@ impl Problem {
         window: (f64, f64),
         alpha_start: Option<f64>,
         max_steps: Option<usize>,
+        max_alpha_step: Option<f64>,
         monitor: Option<Py<PyAny>>,
     ) -> PyResult<Path> {
         let load = Load::affine(f0.as_slice()?.to_vec(), f1.as_slice()?.to_vec()).map_err(to_py)?;
-        self.trace(py, load, window, alpha_start, max_steps, monitor, None)
+        let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
+        self.trace(py, load, opts, monitor, None)
     }
 
     /// Traces a general load: `load(alpha)` returns f (n values); `dload(alpha)` its
     /// derivative (central differences when None). An exception inside either stops the
     /// path; it is kept on the path and re-raised by the Python layer.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (load, dload, n, window, alpha_start, max_steps, monitor))]
+    #[pyo3(signature = (load, dload, n, window, alpha_start, max_steps, max_alpha_step, monitor))]
     fn trace_general(
         &self,
         py: Python<'_>,
@@ -236,8 +238,10 @@ impl Problem {
         window: (f64, f64),
         alpha_start: Option<f64>,
         max_steps: Option<usize>,
+        max_alpha_step: Option<f64>,
         monitor: Option<Py<PyAny>>,
     ) -> PyResult<Path> {
+        let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
         let slot: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
         let wrap = |callable: Py<PyAny>, what: &'static str| {
             let slot = slot.clone();
@@ -276,81 +280,59 @@ impl Problem {
         let f = wrap(load, "load");
         let df = dload.map(|d| wrap(d, "dload"));
         let load = Load::general(n, f, df);
-        self.trace(
-            py,
-            load,
-            window,
-            alpha_start,
-            max_steps,
-            monitor,
-            Some(slot),
-        )
+        self.trace(py, load, opts, monitor, Some(slot))
     }
 }
 
+/// The path options of `trace`: ValueError for `max_steps` = 0 (the other values are
+/// checked by `fricont::Path::new`).
+fn options(
+    window: (f64, f64),
+    alpha_start: Option<f64>,
+    max_steps: Option<usize>,
+    max_alpha_step: Option<f64>,
+) -> PyResult<PathOptions> {
+    let mut opts = PathOptions::window(window.0, window.1);
+    if let Some(a) = alpha_start {
+        opts.alpha_start = a;
+    }
+    if let Some(k) = max_steps {
+        if k == 0 {
+            return Err(PyValueError::new_err("max_steps must be at least 1"));
+        }
+        opts.max_steps = k;
+    }
+    opts.max_alpha_step = max_alpha_step;
+    Ok(opts)
+}
+
 impl Problem {
-    #[allow(clippy::too_many_arguments)]
+    /// Makes the path, starts it at `opts.alpha_start` and runs it (see [`Path::advance`]).
     fn trace(
         &self,
         py: Python<'_>,
         load: Load,
-        window: (f64, f64),
-        alpha_start: Option<f64>,
-        max_steps: Option<usize>,
+        opts: PathOptions,
         monitor: Option<Py<PyAny>>,
-        slot: Option<Arc<Mutex<Option<PyErr>>>>,
+        load_error: Option<Arc<Mutex<Option<PyErr>>>>,
     ) -> PyResult<Path> {
-        let mut opts = PathOptions::window(window.0, window.1);
-        if let Some(a) = alpha_start {
-            opts.alpha_start = a;
-        }
-        if let Some(k) = max_steps {
-            if k == 0 {
-                return Err(PyValueError::new_err("max_steps must be at least 1"));
-            }
-            opts.max_steps = k;
-        }
         let start = opts.alpha_start;
         let problem = self.inner.clone();
         let t0 = std::time::Instant::now();
-        let mut path = fricont::Path::new(problem, load, opts).map_err(to_py)?;
+        let path = fricont::Path::new(problem, load, opts).map_err(to_py)?;
         let setup_s = t0.elapsed().as_secs_f64();
-        let t1 = std::time::Instant::now();
-        // Trace with the GIL released; the monitor and a Python load re-attach.
-        let outcome: Result<(), PyErr> = py.detach(|| {
-            path.start(start, None).map_err(to_py)?;
-            loop {
-                match path.step().map_err(to_py)? {
-                    StepOutcome::End(_) => return Ok(()),
-                    StepOutcome::Transition { events, .. } => {
-                        if let Some(m) = &monitor {
-                            let a = path.events()[events.start].alpha;
-                            let k = path.events()[events.end - 1].transition + 1;
-                            let stop = Python::attach(|py| -> PyResult<bool> {
-                                m.call1(py, (a, k, (events.start, events.end)))?
-                                    .bind(py)
-                                    .is_truthy()
-                            })?;
-                            if stop {
-                                return Ok(());
-                            }
-                        }
-                    }
-                }
-            }
-        });
-        let trace_s = t1.elapsed().as_secs_f64();
-        let callback_error = slot.and_then(|s| s.lock().ok().and_then(|mut g| g.take()));
-        let error = match (outcome, callback_error) {
-            (Err(_), Some(e)) => Some(e),
-            (Err(e), None) => Some(e),
-            (Ok(()), _) => None,
-        };
-        Ok(Path {
+        let path = Path {
             inner: Mutex::new(path),
-            error: Mutex::new(error),
-            timing: Timing { setup_s, trace_s },
-        })
+            error: Mutex::new(None),
+            load_error,
+            timing: Mutex::new(Timing {
+                setup_s,
+                trace_s: 0.0,
+            }),
+            tracer: Mutex::new(None),
+        };
+        path.advance(py, Some(start), monitor)?;
+        Ok(path)
     }
 }
 
@@ -358,15 +340,125 @@ impl Problem {
 #[pyclass(module = "fricont._core", frozen)]
 struct Path {
     inner: Mutex<fricont::Path>,
+    /// The exception that ended the last run (a load's, the monitor's, the library's),
+    /// until taken.
     error: Mutex<Option<PyErr>>,
-    timing: Timing,
+    /// Where a Python load keeps its exception while the library unwinds (general loads).
+    load_error: Option<Arc<Mutex<Option<PyErr>>>>,
+    timing: Mutex<Timing>,
+    /// The thread running the path while it holds `inner` (a call from its own monitor is
+    /// refused instead of waiting for itself).
+    tracer: Mutex<Option<ThreadId>>,
+}
+
+fn poisoned<T>(_: T) -> PyErr {
+    UsageError::new_err("the path is poisoned by an earlier panic")
 }
 
 impl Path {
-    fn lock(&self) -> PyResult<std::sync::MutexGuard<'_, fricont::Path>> {
-        self.inner
+    /// True when the calling thread is running this path (a call from its monitor).
+    fn traced_here(&self) -> bool {
+        self.tracer
             .lock()
-            .map_err(|_| UsageError::new_err("the path is poisoned by an earlier panic"))
+            .is_ok_and(|t| *t == Some(std::thread::current().id()))
+    }
+
+    fn busy() -> PyErr {
+        UsageError::new_err(
+            "the path is being traced: it cannot be used from inside its own monitor (read it \
+             after trace or resume returns)",
+        )
+    }
+
+    /// The path, for a call without the GIL: waits while another thread runs it.
+    fn lock_detached(&self) -> PyResult<MutexGuard<'_, fricont::Path>> {
+        if self.traced_here() {
+            return Err(Self::busy());
+        }
+        self.inner.lock().map_err(poisoned)
+    }
+
+    /// The path, for a call with the GIL: waits (without the GIL, so that a tracing thread
+    /// can call its load or monitor) while another thread runs it.
+    fn lock(&self, py: Python<'_>) -> PyResult<MutexGuard<'_, fricont::Path>> {
+        loop {
+            match self.inner.try_lock() {
+                Ok(g) => return Ok(g),
+                Err(TryLockError::Poisoned(e)) => return Err(poisoned(e)),
+                Err(TryLockError::WouldBlock) if self.traced_here() => return Err(Self::busy()),
+                Err(TryLockError::WouldBlock) => py.detach(|| drop(self.inner.lock())),
+            }
+        }
+    }
+
+    /// Starts the path at `start` (if given) and runs it until it ends, with the GIL
+    /// released; the GIL is taken again only to call a Python load or the monitor. The
+    /// monitor is called as `monitor(alpha, transitions, (first_event, end_event))` after
+    /// each transition point: a true result, or an exception, stops the path
+    /// (`EndReason::Stopped`; a later run continues from there). The exception that ended
+    /// the run is kept for `take_error`. Errors: UsageError when called from the path's
+    /// own monitor.
+    fn advance(
+        &self,
+        py: Python<'_>,
+        start: Option<f64>,
+        monitor: Option<Py<PyAny>>,
+    ) -> PyResult<()> {
+        if self.traced_here() {
+            return Err(Self::busy());
+        }
+        let t = std::time::Instant::now();
+        let mut monitor_error: Option<PyErr> = None;
+        let outcome = py.detach(|| -> PyResult<()> {
+            let mut path = self.inner.lock().map_err(poisoned)?;
+            *self.tracer.lock().map_err(poisoned)? = Some(std::thread::current().id());
+            let mut run = || -> PyResult<()> {
+                if let Some(a) = start {
+                    path.start(a, None).map_err(to_py)?;
+                }
+                path.run_monitored(|_, pr| {
+                    let Some(m) = &monitor else {
+                        return ControlFlow::Continue(());
+                    };
+                    let answer = Python::attach(|py| -> PyResult<bool> {
+                        m.call1(
+                            py,
+                            (pr.alpha, pr.transitions, (pr.events.start, pr.events.end)),
+                        )?
+                        .bind(py)
+                        .is_truthy()
+                    });
+                    match answer {
+                        Ok(false) => ControlFlow::Continue(()),
+                        Ok(true) => ControlFlow::Break(()),
+                        Err(e) => {
+                            monitor_error = Some(e);
+                            ControlFlow::Break(())
+                        }
+                    }
+                })
+                .map_err(to_py)?;
+                Ok(())
+            };
+            let result = run();
+            *self.tracer.lock().map_err(poisoned)? = None;
+            result
+        });
+        if let Ok(mut tm) = self.timing.lock() {
+            tm.trace_s += t.elapsed().as_secs_f64();
+        }
+        // A Python load's own exception is what stopped the path, not the library's
+        // LoadError that wraps it.
+        let load_error = self
+            .load_error
+            .as_ref()
+            .and_then(|s| s.lock().ok().and_then(|mut g| g.take()));
+        let error = match outcome {
+            Err(e) => Some(load_error.unwrap_or(e)),
+            Ok(()) => monitor_error,
+        };
+        *self.error.lock().map_err(poisoned)? = error;
+        Ok(())
     }
 }
 
@@ -377,10 +469,18 @@ impl Path {
         self.error.lock().ok().and_then(|mut e| e.take())
     }
 
+    /// Runs the path on from where it stopped (see `fricont.Path.resume`): nothing happens
+    /// on a path that ended for another reason. The exception that ends the run is kept
+    /// for `take_error`. Errors: UsageError when called from the path's own monitor.
+    #[pyo3(signature = (monitor))]
+    fn resume(&self, py: Python<'_>, monitor: Option<Py<PyAny>>) -> PyResult<()> {
+        self.advance(py, None, monitor)
+    }
+
     /// Events as tuples (alpha, node, from, to, fold, bifurcation, lambda_n, lambda_t,
     /// transition), node and transition 0-based.
     fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let path = self.lock()?;
+        let path = self.lock(py)?;
         let out = PyList::empty(py);
         for e in path.events() {
             out.append((
@@ -401,7 +501,7 @@ impl Path {
     /// Pieces as dicts (alpha_from, alpha_to, classes, direction, orientation, det_sign,
     /// lambda_from, lambda_to).
     fn pieces<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let path = self.lock()?;
+        let path = self.lock(py)?;
         let out = PyList::empty(py);
         for r in path.pieces() {
             let d = PyDict::new(py);
@@ -418,11 +518,11 @@ impl Path {
         Ok(out)
     }
 
-    /// Why the path ended ("window", "max_steps", "closed_loop", "bifurcation", "failed")
-    /// and the failure message, or (None, None) while it could go on (stopped by a
-    /// monitor).
-    fn end_reason(&self) -> PyResult<(Option<&'static str>, Option<String>)> {
-        let path = self.lock()?;
+    /// Why the path ended ("window", "max_steps", "closed_loop", "bifurcation", "failed",
+    /// "stopped") and the failure message, or (None, None) when it was never started (the
+    /// start failed).
+    fn end_reason(&self, py: Python<'_>) -> PyResult<(Option<&'static str>, Option<String>)> {
+        let path = self.lock(py)?;
         Ok(match path.end_reason() {
             Some(EndReason::Failed(m)) => (Some("failed"), Some(m.clone())),
             Some(r) => (Some(r.name()), None),
@@ -432,7 +532,7 @@ impl Path {
 
     /// The start state (alpha, lambda_n, lambda_t, classes, residual; no u).
     fn start_state<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let path = self.lock()?;
+        let path = self.lock(py)?;
         path.start_state()
             .map(|s| state_dict(py, s, false))
             .transpose()
@@ -440,14 +540,16 @@ impl Path {
 
     /// The full state at event k (0-based): u by one back-solve, with the GIL released.
     fn event_state<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyDict>> {
-        let st = py.detach(|| -> PyResult<State> { self.lock()?.event_state(k).map_err(to_py) })?;
+        let st = py.detach(|| -> PyResult<State> {
+            self.lock_detached()?.event_state(k).map_err(to_py)
+        })?;
         state_dict(py, &st, true)
     }
 
     /// Every traced solution at alpha: list of (piece, state dict, continuum).
     fn solutions_at<'py>(&self, py: Python<'py>, alpha: f64) -> PyResult<Bound<'py, PyList>> {
         let sols = py.detach(|| -> PyResult<Vec<fricont::Solution>> {
-            self.lock()?.solutions_at(alpha).map_err(to_py)
+            self.lock_detached()?.solutions_at(alpha).map_err(to_py)
         })?;
         let out = PyList::empty(py);
         for s in &sols {
@@ -457,9 +559,10 @@ impl Path {
     }
 
     /// The JSON report of the CLI (SPEC §8), as text.
-    fn to_json(&self) -> PyResult<String> {
-        let mut path = self.lock()?;
-        Ok(PathReport::from_path(&mut path, self.timing).to_json_string())
+    fn to_json(&self, py: Python<'_>) -> PyResult<String> {
+        let timing = *self.timing.lock().map_err(poisoned)?;
+        let mut path = self.lock(py)?;
+        Ok(PathReport::from_path(&mut path, timing).to_json_string())
     }
 }
 

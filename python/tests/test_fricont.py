@@ -149,7 +149,8 @@ def test_a_load_that_raises_keeps_the_traced_part(sample):
     assert all(e.alpha <= cut + 1e-12 for e in kept.events)
 
 
-def test_the_monitor_stops_the_path_after_three_transition_points(sample):
+def test_the_monitor_stops_the_path_after_three_transition_points_and_resume_ends_it(sample):
+    # Reference: the same path traced without a monitor (the same arithmetic: equal bits).
     ref = trace_sample(sample)
     seen = []
 
@@ -159,11 +160,87 @@ def test_the_monitor_stops_the_path_after_three_transition_points(sample):
 
     prob = fricont.Problem(sample["A"], sample["N"], sample["T"], friction=sample["friction"])
     path = prob.trace(sample["f0"], sample["f1"], window=(-0.5, 1.5), monitor=monitor)
-    assert path.end_reason == "stopped"
+    assert path.end_reason == "stopped" and path.end_message is None
+    assert path.to_dict()["end"]["reason"] == "stopped"
     assert [t for _, t, _ in seen] == [1, 2, 3]
-    assert signature(path) == signature(ref)[: len(path.events)]
-    assert all(abs(e.alpha - r.alpha) <= 1e-12 for e, r in zip(path.events, ref.events))
-    assert path.events[-1].transition == 2
+    # each call: alpha of the new events, which follow those of the previous call
+    assert seen[0][2][0] == 0
+    for (a, t, (first, end)), prev in zip(seen, [None] + seen[:-1]):
+        assert prev is None or first == prev[2][1]
+        assert end > first
+        assert all(ref.events[k].alpha == a and ref.events[k].transition == t - 1
+                   for k in range(first, end))
+    n_stop = seen[-1][2][1]
+    assert len(path.events) == n_stop < len(ref.events)
+    assert [(e.alpha, e.node, e.to_class) for e in path.events] == [
+        (e.alpha, e.node, e.to_class) for e in ref.events[:n_stop]]
+    # resume: from the stop to the reference's end, with the reference's events
+    more = []
+    assert path.resume(monitor=lambda a, t, ev: more.append(t)) is path
+    assert path.end_reason == ref.end_reason == "window"
+    assert path.to_dict()["end"]["reason"] == "window"
+    assert [(e.alpha, e.node, e.from_class, e.to_class, e.transition) for e in path.events] == [
+        (e.alpha, e.node, e.from_class, e.to_class, e.transition) for e in ref.events]
+    assert more == list(range(4, ref.events[-1].transition + 2))
+    assert len(path.pieces) == len(ref.pieces)
+    # resuming a path that ended changes nothing
+    path.resume()
+    assert path.end_reason == "window" and len(path.events) == len(ref.events)
+
+
+def test_an_exception_in_the_monitor_stops_the_path_and_is_raised_with_it(sample):
+    ref = trace_sample(sample)
+
+    class GiveUp(Exception):
+        pass
+
+    def monitor(alpha, transitions, events):
+        if transitions == 2:
+            raise GiveUp("enough at 2")
+        return False
+
+    prob = fricont.Problem(sample["A"], sample["N"], sample["T"], friction=sample["friction"])
+    with pytest.raises(GiveUp, match="enough at 2") as info:
+        prob.trace(sample["f0"], sample["f1"], window=(-0.5, 1.5), monitor=monitor)
+    kept = info.value.path
+    assert kept.end_reason == "stopped"
+    upto = [e for e in ref.events if e.transition <= 1]
+    assert [(e.alpha, e.node) for e in kept.events] == [(e.alpha, e.node) for e in upto]
+    # the path stays usable; a monitor that reads the path from inside its own run is
+    # refused (UsageError, raised like any exception of the monitor), not a deadlock
+    with pytest.raises(fricont.UsageError, match="monitor") as info:
+        kept.resume(monitor=lambda a, t, ev: kept.event_state(ev[0]))
+    assert info.value.path is kept and kept.end_reason == "stopped"
+    upto = [e for e in ref.events if e.transition <= 2]
+    assert [(e.alpha, e.node) for e in kept.events] == [(e.alpha, e.node) for e in upto]
+    kept.resume()
+    assert kept.end_reason == "window"
+    assert [(e.alpha, e.node) for e in kept.events] == [(e.alpha, e.node) for e in ref.events]
+
+
+def test_max_alpha_step_finds_a_narrow_bump_at_the_analytic_alpha():
+    # One node, A = I, N = [1, 0], T = [0, 1] under the normal load
+    # c(alpha) = 0.5 - 0.6 exp(-((alpha - ab)/w)^2) (tests/core_oscillating.rs): the node
+    # opens where the exponential exceeds 5/6, i.e. for |alpha - ab| < w sqrt(ln 1.2).
+    # The default steps (up to 1/8 of the window) never evaluate the load on the bump;
+    # steps of at most 1e-3 find both transitions.
+    ab, w = 21.5 / 64, 2e-3
+    half = w * np.sqrt(np.log(1.2))
+    prob = fricont.Problem(sp.identity(2, format="csr"), [[1.0, 0.0]], [[0.0, 1.0]], friction=0.3)
+
+    def load(a):
+        return np.array([0.5 - 0.6 * np.exp(-(((a - ab) / w) ** 2)), 0.0])
+
+    path = prob.trace(load=load, window=(-1.0, 1.0), max_alpha_step=1e-3)
+    assert path.end_reason == "window"
+    assert [(e.from_class, e.to_class) for e in path.events] == [("stick", "open"), ("open", "stick")]
+    assert abs(path.events[0].alpha - (ab - half)) <= 1e-10
+    assert abs(path.events[1].alpha - (ab + half)) <= 1e-10
+    for bad in (0.0, -1.0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="max_alpha_step"):
+            prob.trace(load=load, window=(-1.0, 1.0), max_alpha_step=bad)
+        with pytest.raises(ValueError, match="max_alpha_step"):
+            prob.trace([0.5, 0.0], [0.0, 0.0], window=(-1.0, 1.0), max_alpha_step=bad)
 
 
 def test_two_threads_trace_at_once_with_the_results_of_one(sample):
