@@ -77,7 +77,7 @@ if ls "$WORK"/fricont_mex.mex* >/dev/null 2>&1 && [ -f ref.txt ]; then
     run_check "fricont_build() from an installed copy links PREFIX/lib (rpath)" build_from_install
     run_check "example matlab/examples/trace_sample.m: its table equals the C interface's events" \
         bash -c "$(declare -f octave_eval compare_table); \
-            octave_eval \"addpath('$WORK'); run('$M/examples/trace_sample.m')\" > example.txt &&
+            octave_eval \"addpath('$WORK'); addpath('$M/examples'); trace_sample\" > example.txt &&
             cat example.txt && compare_table ref.txt example.txt"
     run_check "affine load: events equal the C interface's" compare_events ref.txt affine.txt
     run_check "A as its lower triangle (storage 'lower'): the events of the full matrix with those entries" \

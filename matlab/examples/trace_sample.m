@@ -9,12 +9,14 @@
 % significant digits) and the total normal contact force at each.
 %
 % From the repository root, after `cargo build --release`:
-%   octave-cli --eval "run matlab/examples/trace_sample.m"
+%   octave-cli --eval "addpath('matlab/examples'); trace_sample"
 % Against an installed copy (scripts/install.sh PREFIX), with a problem directory of
 % your own (`fricont gen-rect DIR` writes one):
-%   case_dir = 'DIR'; run PREFIX/share/fricont/matlab/examples/trace_sample.m
-% The script puts the binding's folder (the parent of this one) on the path and builds
-% the MEX gateway when it is missing (fricont_build).
+%   addpath PREFIX/share/fricont/matlab/examples; case_dir = 'DIR'; trace_sample
+% Call it by name, as here: `run FILE` changes into the script's folder first, and a
+% relative case_dir would then name the wrong place. The script puts the binding's
+% folder (the parent of this one) on the path and builds the MEX gateway when it is
+% missing (fricont_build).
 here = fileparts(mfilename('fullpath'));
 if ~exist('fricont_trace', 'file')
   addpath(fullfile(here, '..'));
