@@ -2,6 +2,8 @@
 # The C++ wrapper's tests: include/fricont.hpp compiled with -std=c++17 -Wall -Wextra
 # -Wpedantic -Werror, run on the sample problem against the C interface's events, and
 # run again under valgrind (no invalid access, no definite leak) when valgrind is there.
+# The C++ example examples-cpp/q1_rectangle.cpp, built the same way, must print what
+# its C twin examples-c/q1_rectangle.c prints (the same problem, the same events).
 source "$(dirname "$0")/../tests-install/common.sh"
 
 need_cmd g++ g++ || { fail "g++ available"; finish; }
@@ -16,6 +18,14 @@ run_check "fricont.h compiles as C++ alone" \
 run_check "test_wrapper.cpp compiles (-Werror)" \
     g++ $CXXFLAGS -I"$ROOT/include" "$ROOT/cpp-tests/test_wrapper.cpp" \
     -L"$LIBDIR" -lfricont -Wl,-rpath,"$LIBDIR" -pthread -o "$WORK/test_wrapper"
+
+run_check "examples-cpp/q1_rectangle.cpp (-Werror): the output of examples-c/q1_rectangle.c" \
+    bash -c "g++ $CXXFLAGS -I'$ROOT/include' '$ROOT/examples-cpp/q1_rectangle.cpp' -L'$LIBDIR' \
+            -lfricont -Wl,-rpath,'$LIBDIR' -o '$WORK/q1_cpp' &&
+        cc -std=c99 -O1 -I'$ROOT/include' '$ROOT/examples-c/q1_rectangle.c' -L'$LIBDIR' \
+            -lfricont -Wl,-rpath,'$LIBDIR' -lm -o '$WORK/q1_c' &&
+        '$WORK/q1_cpp' > '$WORK/q1_cpp.txt' && '$WORK/q1_c' > '$WORK/q1_c.txt' &&
+        diff '$WORK/q1_c.txt' '$WORK/q1_cpp.txt' && grep -q 'stick  -> slip+' '$WORK/q1_cpp.txt'"
 
 if [ -x "$WORK/test_wrapper" ] && [ -f "$WORK/ref.txt" ]; then
     "$WORK/test_wrapper" "$CASE" "$WORK/ref.txt" >"$WORK/out.txt" 2>&1

@@ -34,10 +34,32 @@
 #include <fricont.h>
 
 #include <pthread.h>
+#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* ---- Raising errors ------------------------------------------------------------------
+ * Octave's mexErrMsgIdAndTxt puts the MEX file's name in front of every message
+ * ("fricont_mex: fricont: ..."); MATLAB's does not. So errors are raised by calling
+ * MATLAB's error() with a struct {message, identifier}: the same text in both. The
+ * macro below routes every mexErrMsgIdAndTxt of this file there. Like
+ * mexErrMsgIdAndTxt, it does not return (error() unwinds out of the MEX function). */
+static void raise_error(const char *id, const char *fmt, ...) {
+    char msg[1400];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    const char *fields[] = {"message", "identifier"};
+    mxArray *err = mxCreateStructMatrix(1, 1, 2, fields);
+    mxSetField(err, 0, "message", mxCreateString(msg));
+    mxSetField(err, 0, "identifier", mxCreateString(id));
+    mexCallMATLAB(0, NULL, 1, &err, "error");
+    mexErrMsgIdAndTxt(id, "%s", msg); /* not reached */
+}
+#define mexErrMsgIdAndTxt raise_error
 
 /* ---- Worker thread (paths with a MATLAB-function load) ---------------------------- */
 
@@ -267,7 +289,13 @@ static void raise_status(int32_t st, const char *what) {
     const char *s = strncmp(name, "FRICONT_", 8) == 0 ? name + 8 : "unknown";
     while (s[k] && s[k] != ':' && k < sizeof id - 10) k++;
     snprintf(id, sizeof id, "fricont:%.*s", (int)k, s);
-    mexErrMsgIdAndTxt(id, "fricont: %s: %s", what, len ? msg : name);
+    /* The library's message names the argument and the cause ("A (CSR): ..."); `what`
+     * (the request that ran into it, e.g. the first call that factorises A) only stands
+     * in when there is no message. */
+    if (len)
+        mexErrMsgIdAndTxt(id, "fricont: %s", msg);
+    else
+        mexErrMsgIdAndTxt(id, "fricont: %s: %s", what, name);
 }
 
 static void check(int32_t st, const char *what) {

@@ -1,9 +1,9 @@
-function path = fricont_trace(A, N, T, f0, f1, F, window, opts)
+function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %FRICONT_TRACE Trace the solution path of a 2D contact problem with Coulomb friction.
 %
-%   path = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1])
-%   path = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1], opts)
-%   path = fricont_trace(A, N, T, @f, @df, F, [alpha0 alpha1], opts)
+%   res = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1])
+%   res = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1], opts)
+%   res = fricont_trace(A, N, T, @f, @df, F, [alpha0 alpha1], opts)
 %
 %   A      n-by-n stiffness, sparse, symmetric positive definite (Dirichlet dofs
 %          eliminated). Passed in MATLAB's own CSC form, not copied before the library
@@ -22,8 +22,9 @@ function path = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %          storage ('full' default, 'lower' or 'upper': which triangle of A is stored),
 %          max_steps (default 10000), zero_tol (default 1e-11),
 %          guess (2p-vector [lambda_n; lambda_t] for the start solve).
+%          Any other field is an error (a misspelt option is never ignored).
 %
-%   path   struct:
+%   res    struct (name it anything but "path", MATLAB's search-path function):
 %     events  struct array, one per node changing class, in order: index, transition,
 %             alpha, node (contact nodes count from 1), from, to ('open', 'stick',
 %             'slip+', 'slip-'), fold, bifurcation, residual, and the state after it:
@@ -43,8 +44,14 @@ function path = fricont_trace(A, N, T, f0, f1, F, window, opts)
   if nargin < 8 || isempty(opts)
     opts = struct();
   end
-  if ~isstruct(opts)
-    error('fricont:argument', 'fricont_trace: opts must be a struct');
+  if ~isstruct(opts) || ~isscalar(opts)
+    error('fricont:argument', 'fricont_trace: opts must be a scalar struct');
+  end
+  valid = {'gap', 'r', 'storage', 'max_steps', 'zero_tol', 'guess'};
+  unknown = setdiff(fieldnames(opts), valid);
+  if ~isempty(unknown)
+    error('fricont:argument', 'fricont_trace: unknown option ''%s''; the options are: %s', ...
+          strjoin(unknown(:).', ''', '''), strjoin(valid, ', '));
   end
   if ~isnumeric(window) || numel(window) ~= 2
     error('fricont:argument', 'fricont_trace: the window is [alpha_start alpha_end]');
@@ -94,11 +101,11 @@ function path = fricont_trace(A, N, T, f0, f1, F, window, opts)
   fricont_drive(id, load, n, 'start', double(window(1)), guess);
   fricont_drive(id, load, n, 'run');
 
-  path = fricont_mex('path_result', id);
-  path.r = r;
-  path.window = double(window(:).');
-  path.handle = handle;
-  path.load = load;
+  res = fricont_mex('path_result', id);
+  res.r = r;
+  res.window = double(window(:).');
+  res.handle = handle;
+  res.load = load;
 end
 
 function S = as_sparse(M, name)

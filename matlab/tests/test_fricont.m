@@ -3,23 +3,24 @@ function failures = test_fricont(case_dir, out_dir)
 %   Writes the traced events to out_dir/{affine,handle,handle_nodf,lower}.txt (compared
 %   with the C interface's by matlab/run.sh) and prints "ok NAME" / "FAIL NAME: why".
   failures = 0;
-  c = read_case(case_dir);
+  confirm_recursive_rmdir(false, 'local');      % rmdir(d, 's') without asking (Octave)
+  c = fricont_read_case(case_dir);
   n = size(c.A, 1);
   p = size(c.N, 1);
   opts = struct('gap', c.gap);
   win = [c.alpha_start c.alpha_end];
 
   % 1. Affine load.
-  path = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts);
-  write_events(fullfile(out_dir, 'affine.txt'), path, @(a) a);
-  failures = failures + check('affine: ends at the window', strcmp(path.end_reason, 'window'));
-  failures = failures + check('affine: pieces = events + 1', numel(path.pieces) == numel(path.events) + 1);
+  res = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts);
+  write_events(fullfile(out_dir, 'affine.txt'), res, @(a) a);
+  failures = failures + check('affine: ends at the window', strcmp(res.end_reason, 'window'));
+  failures = failures + check('affine: pieces = events + 1', numel(res.pieces) == numel(res.events) + 1);
   failures = failures + check('handle locks the MEX file', fricont_mex('is_locked'));
-  ev = path.events;
+  ev = res.events;
 
   % 2. Solutions between the first two events satisfy the equations (checked here).
   alpha = (ev(1).alpha + ev(2).alpha) / 2;
-  S = fricont_solutions_at(path, alpha);
+  S = fricont_solutions_at(res, alpha);
   failures = failures + check('solutions_at: one solution on piece 2', numel(S) == 1 && S(1).piece == 2);
   f = c.f0 + alpha * c.f1;
   [ok, why] = check_solution(c, S(1), f);
@@ -27,7 +28,7 @@ function failures = test_fricont(case_dir, out_dir)
   [ok, why] = check_solution(c, ev(1), c.f0 + ev(1).alpha * c.f1);
   failures = failures + check('event state: equilibrium and contact conditions', ok, why);
   failures = failures + check('solutions_at: none outside the traced range', ...
-                    isempty(fricont_solutions_at(path, c.alpha_end + 1)));
+                    isempty(fricont_solutions_at(res, c.alpha_end + 1)));
 
   % 3. A load given as a function handle, f(s) = f0 + sinh(s) f1, with and without
   %    its derivative: the events are at asinh of the affine ones.
@@ -53,7 +54,7 @@ function failures = test_fricont(case_dir, out_dir)
 
   % 5. An error in the load function: raised by fricont_trace, after the library call
   %    returned; nothing is left allocated.
-  clear path ph ph2 pl ps;
+  clear res ph ph2 pl ps;
   failures = failures + check('every handle freed when the structs are cleared', fricont_mex('count') == 0);
   failures = failures + check('MEX file unlocked without handles', ~fricont_mex('is_locked'));
   stop = (ev(2).alpha + ev(3).alpha) / 2;
@@ -109,7 +110,72 @@ function failures = test_fricont(case_dir, out_dir)
   end
   failures = failures + check('handle of the wrong class: fricont:handle', strcmp(ident, 'fricont:handle'), ident);
 
-  % 7. A request MATLAB abandons (as after Ctrl-C) does not hang or leak: freeing the
+  % 7. Options and messages: a misspelt option field is an error naming it and the
+  %    valid ones; messages read "fricont: <the library's message>", without the MEX
+  %    file's name (Octave's mexErrMsgIdAndTxt adds it) or the request's tag.
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, struct('gapp', c.gap)));
+  failures = failures + check('unknown option field: an error naming it and the valid ones', ...
+                    strcmp(ident, 'fricont:argument') && ~isempty(strfind(msg, '''gapp''')) && ...
+                    ~isempty(strfind(msg, 'gap, r, storage, max_steps, zero_tol, guess')), msg);
+  An = c.A;
+  An(1, 2) = An(1, 2) + 1;
+  [ident, msg] = caught(@() fricont_trace(An, c.N, c.T, c.f0, c.f1, c.F, win, opts));
+  failures = failures + check('non-symmetric A: "fricont: A is not symmetric: A(1, 2) ..."', ...
+                    strcmp(ident, 'fricont:ERR_NOT_SYMMETRIC') && ...
+                    strncmp(msg, 'fricont: A is not symmetric: A(1, 2) and A(2, 1)', 48), msg);
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, struct('r', -1)));
+  failures = failures + check('r = -1: "fricont: r = -1, must be ..."', ...
+                    strcmp(ident, 'fricont:ERR_RANGE') && strncmp(msg, 'fricont: r = -1, must be', 24), msg);
+  [ident, msg] = caught(@() fricont_mex('path_result', 3));
+  failures = failures + check('MEX argument error: "fricont: a handle must be a uint64 scalar"', ...
+                    strcmp(msg, 'fricont: a handle must be a uint64 scalar'), [ident ' ' msg]);
+  failures = failures + check('every handle freed after the errors', fricont_mex('count') == 0);
+
+  % 8. fricont_read_case: other Matrix Market forms of the same matrices read the same
+  %    (N as a dense 'array', A as the lower triangle of a 'symmetric' file with integer
+  %    indices written by hand here); 'pattern' is a clear error naming the file.
+  d = tempname();
+  mkdir(d);
+  for f = {'A.mtx', 'T.mtx', 'f0.txt', 'f1.txt', 'gap.txt', 'meta.json'}
+    copyfile(fullfile(case_dir, f{1}), fullfile(d, f{1}));
+  end
+  fid = fopen(fullfile(d, 'N.mtx'), 'w');
+  fprintf(fid, '%%%%MatrixMarket matrix array real general\n%% dense, column by column\n%d %d\n', p, n);
+  fprintf(fid, '%.17g\n', full(c.N));
+  fclose(fid);
+  [i, j, v] = find(tril(c.A));
+  fid = fopen(fullfile(d, 'A.mtx'), 'w');
+  fprintf(fid, '%%%%MatrixMarket matrix coordinate real symmetric\n%d %d %d\n', n, n, numel(v));
+  fprintf(fid, '%d %d %.17g\n', [i j v].');
+  fclose(fid);
+  c2 = fricont_read_case(d);
+  failures = failures + check('read_case: array N and symmetric A equal the coordinate files', ...
+                    isequal(c2.N, c.N) && isequal(c2.A, tril(c.A) + tril(c.A, -1).'));
+  fid = fopen(fullfile(d, 'T.mtx'), 'w');
+  fprintf(fid, '%%%%MatrixMarket matrix coordinate pattern general\n%d %d 1\n1 1\n', p, n);
+  fclose(fid);
+  [ident, msg] = caught(@() fricont_read_case(d));
+  failures = failures + check('read_case: a pattern file is an error naming the file', ...
+                    strcmp(ident, 'fricont:read') && ~isempty(strfind(msg, fullfile(d, 'T.mtx'))) && ...
+                    ~isempty(strfind(msg, 'pattern')), msg);
+  rmdir(d, 's');
+
+  % 9. fricont_build names what is missing and what to do: a repository without a
+  %    built library, a directory that is neither.
+  d = tempname();
+  mkdir(fullfile(d, 'include'));
+  fclose(fopen(fullfile(d, 'Cargo.toml'), 'w'));
+  fclose(fopen(fullfile(d, 'include', 'fricont.h'), 'w'));
+  [ident, msg] = caught(@() fricont_build(d, d));
+  failures = failures + check('fricont_build: a repository without target/release/libfricont.so', ...
+                    strcmp(ident, 'fricont:build') && ~isempty(strfind(msg, 'libfricont.so not found')) && ...
+                    ~isempty(strfind(msg, 'cargo build --release')), msg);
+  [ident, msg] = caught(@() fricont_build(fullfile(d, 'nothing-here')));
+  failures = failures + check('fricont_build: not a directory', ...
+                    strcmp(ident, 'fricont:build') && ~isempty(strfind(msg, 'is not a directory')), msg);
+  rmdir(d, 's');
+
+  % 10. A request MATLAB abandons (as after Ctrl-C) does not hang or leak: freeing the
   %    handle ends the pending library call.
   prob = fricont_mex('problem_new', c.A, 'full', c.N.', c.T.');
   fricont_mex('problem_set', prob, 'friction', c.F);
@@ -121,6 +187,18 @@ function failures = test_fricont(case_dir, out_dir)
   fricont_mex('free', id);
   failures = failures + check('abandoned request: handle freed', fricont_mex('count') == 0);
   fprintf('matlab test_fricont: %d failed check(s)\n', failures);
+end
+
+% The identifier and message of the error fn() raises ('' if none).
+function [ident, msg] = caught(fn)
+  ident = '';
+  msg = '';
+  try
+    fn();
+  catch err
+    ident = err.identifier;
+    msg = err.message;
+  end
 end
 
 function f = failing_load(a, stop, c)
@@ -176,13 +254,13 @@ function [ok, why] = check_solution(c, s, f)
 end
 
 % The events in the plain text form of tests-install/trace_case.c (alpha mapped).
-function write_events(file, path, map)
+function write_events(file, res, map)
   fid = fopen(file, 'w');
-  fprintf(fid, 'start %.17g %.3e\n', map(path.start.alpha), path.start.residual);
-  for e = path.events(:).'
+  fprintf(fid, 'start %.17g %.3e\n', map(res.start.alpha), res.start.residual);
+  for e = res.events(:).'
     fprintf(fid, 'event %d %d %.17g %d %s %s %d %d\n', e.index, e.transition, map(e.alpha), ...
             e.node, e.from, e.to, e.fold, e.bifurcation);
   end
-  fprintf(fid, 'end %s %d\n', path.end_reason, numel(path.pieces));
+  fprintf(fid, 'end %s %d\n', res.end_reason, numel(res.pieces));
   fclose(fid);
 end
