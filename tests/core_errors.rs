@@ -369,6 +369,9 @@ fn not_positive_definite_reports_the_pivot() {
             Error::NotSpd { row, pivot } => {
                 assert_eq!(row, k, "{e}");
                 assert!(pivot < 4);
+                // the message counts from 1, as every message does
+                let m = e.to_string();
+                assert!(m.contains(&format!("row {} of A (1-based", k + 1)), "{m}");
             }
             e => panic!("diag({bad}): {e:?}"),
         }
