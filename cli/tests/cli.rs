@@ -551,7 +551,24 @@ fn broken_matrix_market_files() {
     expect_input_error(
         "A.mtx",
         Some("%%MatrixMarket matrix array real general\n4 4\n"),
-        &["A.mtx:1:", "bad header"],
+        &["A.mtx:2:", "only 0 values, expected 16 values"],
+    );
+    expect_input_error(
+        "A.mtx",
+        Some("%%MatrixMarket matrix coordinate pattern symmetric\n4 4 4\n1 1\n2 2\n3 3\n4 4\n"),
+        &["A.mtx:1:", "\"pattern\" is not supported"],
+    );
+    expect_input_error(
+        "N.mtx",
+        Some("%%MatrixMarket matrix coordinate complex general\n2 4 2\n1 1 1 0\n2 3 1 0\n"),
+        &["N.mtx:1:", "\"complex\" is not supported"],
+    );
+    expect_input_error(
+        "A.mtx",
+        Some(
+            "%%MatrixMarket matrix coordinate real hermitian\n4 4 4\n1 1 2\n2 2 3\n3 3 5\n4 4 4\n",
+        ),
+        &["A.mtx:1:", "\"hermitian\" is not supported"],
     );
     expect_input_error(
         "N.mtx",
