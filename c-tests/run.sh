@@ -48,6 +48,7 @@ build status $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/status.c c-tests/
 build paths $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/paths.c c-tests/common.c -o "$OUT/paths" "${LINK[@]}" -lm -lpthread
 build cholmod_ref $C -I/usr/include/suitesparse "${WARN[@]}" c-tests/cholmod_ref.c c-tests/common.c -o "$OUT/cholmod_ref" "${LINK[@]}" -lcholmod -lm
 build monitor $C "${WARN[@]}" c-tests/monitor.c c-tests/common.c -o "$OUT/monitor" "${LINK[@]}" -lm
+build csr_input $C "${WARN[@]}" c-tests/csr_input.c c-tests/common.c -o "$OUT/csr_input" "${LINK[@]}" -lm
 build oom $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/oom.c c-tests/common.c -o "$OUT/oom" "${LINK[@]}" -lm
 build q1_rectangle $C "${WARN[@]}" examples-c/q1_rectangle.c -o "$OUT/q1_rectangle" "${LINK[@]}" -lm
 
@@ -107,6 +108,7 @@ PY
     done
     run "loads and threads: sample" "$OUT/paths" "$SAMPLE"
     run "monitor, largest step, re-entrant callbacks: sample" "$OUT/monitor" "$SAMPLE"
+    run "CSR input (int32 indices, duplicates): sample" "$OUT/csr_input" "$SAMPLE"
     # the same events as the CLI (when the CLI can trace)
     CLI="$LIBDIR/fricont"
     if [ -x "$CLI" ] && "$CLI" trace "$SAMPLE" --json "$OUT/sample-cli.json" >/dev/null 2>&1 && command -v python3 >/dev/null; then
@@ -147,6 +149,7 @@ if command -v valgrind >/dev/null; then
     run "valgrind CHOLMOD reference: Q1 example, via solve" "${VG[@]}" "$OUT/cholmod_ref" "$Q1" --via solve
     run "valgrind CHOLMOD reference: Q1 example, via condensed" "${VG[@]}" "$OUT/cholmod_ref" "$Q1" --via condensed
     run "valgrind loads and threads: Q1 example" "${VG[@]}" "$OUT/paths" "$Q1"
+    run "valgrind CSR input (int32 indices, duplicates): Q1 example" "${VG[@]}" "$OUT/csr_input" "$Q1"
     if [ -f "$SAMPLE/meta.json" ]; then
         run "valgrind CHOLMOD reference: sample" "${VG[@]}" "$OUT/cholmod_ref" "$SAMPLE"
         run "valgrind monitor, largest step, re-entrant callbacks: sample" "${VG[@]}" "$OUT/monitor" "$SAMPLE"

@@ -98,11 +98,20 @@ static void test_csr_errors(void) {
     b = a;
     b.col_idx = ci_neg;
     EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "column index -1");
-    /* duplicate entry */
+    /* duplicate entries are summed: A(0, 0) = 1.5 + 0.5 gives A = diag(2, 1), the block's
+     * A, so the default r is the block's (W = diag(1/2, 1), r0 = 2p / trace W = 2 / 1.5) */
     int64_t rp_dup[] = {0, 2, 3}, ci_dup[] = {0, 0, 1};
-    double v_dup[] = {1.0, 1.0, 1.0};
+    double v_dup[] = {1.5, 0.5, 1.0};
     b = mk(2, 2, 3, rp_dup, ci_dup, v_dup, 0);
-    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "duplicate");
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_OK, "");
+    double r_dup = 0, r0_dup = 0;
+    EXPECT(fricont_problem_r(p, &r_dup, &r0_dup), FRICONT_OK, "");
+    CHECK(fabs(r0_dup - 2.0 / 1.5) <= 1e-15, "duplicates summed: r0 = %.17g", r0_dup);
+    fricont_problem_free(p);
+    /* a sum of duplicates that overflows */
+    double v_big[] = {1e308, 1e308, 1.0};
+    b = mk(2, 2, 3, rp_dup, ci_dup, v_big, 0);
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_NONFINITE, "sum to inf");
     /* index base 2 */
     b = a;
     b.index_base = 2;
@@ -836,6 +845,111 @@ static void test_host_input(void) {
     CHECK(sd.finalized == 1, "user data finalized %d times after the last free", sd.finalized);
 }
 
+/* CSR with int32_t indices (fricont_csr_i32, the _i32 constructors): the block problem
+ * gives the hand-derived event, and bad input gives the statuses of the int64 API. */
+static fricont_csr_i32 mk32(int64_t nr, int64_t nc, int64_t nnz, int32_t *rp, int32_t *ci, double *v,
+                            int64_t base) {
+    fricont_csr_i32 m = {nr, nc, nnz, rp, ci, v, base};
+    return m;
+}
+
+static void block_event_at_half(fricont_problem *p, const char *what) {
+    fricont_path *path = NULL;
+    EXPECT(fricont_problem_set_friction(p, 0.5), FRICONT_OK, "");
+    EXPECT(fricont_path_new_affine(p, f0, f1, 2, &path), FRICONT_OK, "");
+    EXPECT(fricont_path_set_window(path, 0.0, 1.0), FRICONT_OK, "");
+    EXPECT(fricont_path_start(path, 0.0, NULL, 0), FRICONT_OK, "");
+    EXPECT(fricont_path_run(path), FRICONT_END, "");
+    int64_t ne = 0;
+    fricont_event ev = {0};
+    EXPECT(fricont_path_event_count(path, &ne), FRICONT_OK, "");
+    EXPECT(fricont_path_event(path, 0, &ev), FRICONT_OK, "");
+    CHECK(ne == 1 && fabs(ev.alpha - 0.5) <= 1e-15 && ev.node == 0 && ev.from == FRICONT_STICK &&
+              ev.to == FRICONT_SLIP_PLUS,
+          "%s: %lld events, the first at %.17g", what, (long long)ne, ev.alpha);
+    fricont_path_free(path);
+}
+
+static void test_csr_i32(void) {
+    int32_t a_rp32[] = {0, 1, 2}, a_ci32[] = {0, 1}, n_rp32[] = {0, 1}, n_ci32[] = {0}, t_rp32[] = {0, 1},
+            t_ci32[] = {1};
+    fricont_csr_i32 a = mk32(2, 2, 2, a_rp32, a_ci32, a_v, 0), n = mk32(1, 2, 1, n_rp32, n_ci32, n_v, 0),
+                    t = mk32(1, 2, 1, t_rp32, t_ci32, t_v, 0);
+    fricont_problem *p = NULL;
+    EXPECT(fricont_problem_new_i32(&a, FRICONT_STORAGE_FULL, &n, &t, &p), FRICONT_OK, "");
+    block_event_at_half(p, "int32 CSR");
+    fricont_problem_free(p);
+    /* 1-based, lower storage, with a duplicate in A (2 = 1.25 + 0.75) */
+    int32_t a_rp1[] = {1, 3, 4}, a_ci1[] = {1, 1, 2}, n_rp1[] = {1, 2}, n_ci1[] = {1}, t_rp1[] = {1, 2},
+            t_ci1[] = {2};
+    double a_v1[] = {1.25, 0.75, 1.0};
+    fricont_csr_i32 a1 = mk32(2, 2, 3, a_rp1, a_ci1, a_v1, 1), n1 = mk32(1, 2, 1, n_rp1, n_ci1, n_v, 1),
+                    t1 = mk32(1, 2, 1, t_rp1, t_ci1, t_v, 1);
+    EXPECT(fricont_problem_new_i32(&a1, FRICONT_STORAGE_LOWER, &n1, &t1, &p), FRICONT_OK, "");
+    block_event_at_half(p, "int32 CSR, 1-based, lower, duplicates");
+    fricont_problem_free(p);
+    /* the host's solve with int32 N, T */
+    solve_data sd = {0, 0, 0, 0, 0};
+    EXPECT(fricont_problem_new_solve_i32(2, diag_solve, &sd, solve_finalize, 1, &n, &t, &p), FRICONT_OK, "");
+    block_event_at_half(p, "int32 CSR, host's solve");
+    fricont_problem_free(p);
+    CHECK(sd.finalized == 1, "int32 host solve: user data finalized %d times", sd.finalized);
+
+    /* bad input: the statuses of the int64 API */
+    fricont_csr_i32 b = a;
+    p = (fricont_problem *)&b; /* must be overwritten with NULL */
+    EXPECT(fricont_problem_new_i32(NULL, 0, &n, &t, &p), FRICONT_ERR_NULL, "A is NULL");
+    CHECK(p == NULL, "out is cleared on failure (int32)");
+    b.row_ptr = NULL;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_NULL, "A.row_ptr");
+    int32_t rp_dec[] = {0, 2, 1}, rp_neg[] = {0, -1, 2}, rp_short[] = {0, 1, 1}, rp_base[] = {1, 2, 3};
+    int32_t ci_neg[] = {-1, 1}, ci_out[] = {0, 2}, ci_min[] = {0, INT32_MIN}, ci_max[] = {INT32_MAX, 1};
+    b = a;
+    b.row_ptr = rp_dec;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "decreases");
+    b.row_ptr = rp_neg;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "row pointer decreases");
+    b.row_ptr = rp_short;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "row_ptr");
+    b.row_ptr = rp_base; /* 1-based pointers declared 0-based */
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "row_ptr[0] = 1");
+    b = a;
+    b.col_idx = ci_neg;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "column index -1");
+    b.col_idx = ci_out;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "column index 2");
+    b.col_idx = ci_min;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "column index -2147483648");
+    b.col_idx = ci_max;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "column index 2147483647");
+    b = a;
+    b.index_base = 2;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "index_base is 2");
+    b = a;
+    b.nnz = -1;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_LENGTH, "A.nnz");
+    double v_nan[] = {2.0, NAN};
+    b = a;
+    b.values = v_nan;
+    EXPECT(fricont_problem_new_i32(&b, 0, &n, &t, &p), FRICONT_ERR_NONFINITE, "NaN");
+    fricont_csr_i32 t3 = mk32(1, 3, 1, t_rp32, t_ci32, t_v, 0);
+    EXPECT(fricont_problem_new_i32(&a, 0, &n, &t3, &p), FRICONT_ERR_LENGTH, "T is 1x3");
+    EXPECT(fricont_problem_new_i32(&a, 7, &n, &t, &p), FRICONT_ERR_RANGE, "a_storage = 7");
+    /* the same through the host's solve constructor; the user data is finalized at once */
+    fricont_csr_i32 bn = n;
+    bn.col_idx = ci_neg;
+    sd.finalized = 0;
+    EXPECT(fricont_problem_new_solve_i32(2, diag_solve, &sd, solve_finalize, 1, &bn, &t, &p), FRICONT_ERR_CSR,
+           "column index -1");
+    CHECK(sd.finalized == 1, "a failing int32 constructor finalizes the user data (%d)", sd.finalized);
+    bn = n;
+    bn.row_ptr = rp_neg;
+    bn.nrows = 2;
+    EXPECT(fricont_problem_new_solve_i32(2, diag_solve, &sd, NULL, 1, &bn, &t, &p), FRICONT_ERR_CSR, "row pointer");
+    EXPECT(fricont_problem_new_solve_i32(2, diag_solve, &sd, NULL, 1, &n, NULL, &p), FRICONT_ERR_NULL, "T");
+    EXPECT(fricont_problem_new_solve_i32(2, NULL, &sd, NULL, 1, &n, &t, &p), FRICONT_ERR_NULL, "solve");
+}
+
 /* The library must not start threads in the host program (factorisations and solves run
  * on the calling thread): after everything above, this process still has one thread. */
 static void test_no_threads_started(void) {
@@ -861,6 +975,7 @@ int main(void) {
     test_fold();
     test_bifurcation();
     test_host_input();
+    test_csr_i32();
     test_no_threads_started();
     return finish("status");
 }

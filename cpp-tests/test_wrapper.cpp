@@ -172,6 +172,10 @@ struct BandCholesky {
     }
 };
 
+std::vector<int32_t> to32(const std::vector<int64_t> &v) {
+    return std::vector<int32_t>(v.begin(), v.end());
+}
+
 fricont::Problem make_problem(const casefile::Case &c) {
     fricont::CsrRef a(c.a.nrows, c.a.ncols, c.a.row_ptr, c.a.col_idx, c.a.values);
     fricont::CsrRef n(c.n.nrows, c.n.ncols, c.n.row_ptr, c.n.col_idx, c.n.values);
@@ -454,6 +458,59 @@ int main(int argc, char **argv) {
         }
         report("a throwing solve gives FRICONT_ERR_SOLVE_CALLBACK", status == FRICONT_ERR_SOLVE_CALLBACK,
                std::to_string(status));
+
+        // the host's solve with int32_t N and T: the same events
+        std::vector<int32_t> np32 = to32(c.n.row_ptr), nc32 = to32(c.n.col_idx), tp32 = to32(c.t.row_ptr),
+                             tc32 = to32(c.t.col_idx);
+        fricont::CsrRef32 n32(c.n.nrows, c.n.ncols, np32, nc32, c.n.values);
+        fricont::CsrRef32 t32(c.t.nrows, c.t.ncols, tp32, tc32, c.t.values);
+        fricont::Problem hosted32 = fricont::Problem::with_solve(n, solve, n32, t32, 8);
+        hosted32.set_friction(c.friction);
+        hosted32.set_gap(c.gap);
+        fricont::Path h32 = fricont::Path::affine(hosted32, c.f0, c.f1);
+        h32.set_window(c.alpha_start, c.alpha_end);
+        h32.start(c.alpha_start);
+        report("host's solve, int32 N, T: ends at the window", h32.run() == fricont::EndReason::Window);
+        std::vector<fricont::Event> h32ev = h32.events();
+        d = compare(h32ev, ref, 1e-10, same, ref.size());
+        report("host's solve, int32 N, T: events equal the C reference", d.empty() && h32ev.size() == ref.size(),
+               d);
+    }
+
+    // 9. int32_t CSR (CsrRef32): the same arrays with 32-bit indices give the C reference's
+    //    events bit for bit; bad 32-bit input throws the C API's status.
+    {
+        std::vector<int32_t> ap = to32(c.a.row_ptr), ac = to32(c.a.col_idx), np = to32(c.n.row_ptr),
+                             nc = to32(c.n.col_idx), tp = to32(c.t.row_ptr), tc = to32(c.t.col_idx);
+        fricont::CsrRef32 a(c.a.nrows, c.a.ncols, ap, ac, c.a.values);
+        fricont::CsrRef32 n(c.n.nrows, c.n.ncols, np, nc, c.n.values);
+        fricont::CsrRef32 t(c.t.nrows, c.t.ncols, static_cast<int64_t>(tc.size()), tp.data(), tc.data(),
+                            c.t.values.data());
+        fricont::Problem p32(a, c.a.symmetric ? fricont::Storage::Lower : fricont::Storage::Full, n, t);
+        p32.set_friction(c.friction);
+        p32.set_gap(c.gap);
+        fricont::Path q = fricont::Path::affine(p32, c.f0, c.f1);
+        q.set_window(c.alpha_start, c.alpha_end);
+        q.start(c.alpha_start);
+        report("int32 CSR: ends at the window", q.run() == fricont::EndReason::Window);
+        std::vector<fricont::Event> qev = q.events();
+        std::string d = compare(qev, ref, 0.0, same, ref.size());
+        report("int32 CSR: events equal the C reference", d.empty() && qev.size() == ref.size(), d);
+        const std::pair<std::vector<int32_t>, std::vector<int32_t>> bad[3] = {
+            {{0, 1, 2}, {0, -1}}, {{0, 2, 1}, {0, 1}}, {{0, 1, 2}, {0, 2}}};
+        const char *what[3] = {"a negative column", "a decreasing row pointer", "a column out of range"};
+        std::vector<double> val{1.0, 1.0};
+        for (int k = 0; k < 3; k++) {
+            fricont::CsrRef32 b(2, 2, bad[k].first, bad[k].second, val);
+            int32_t status = 0;
+            try {
+                fricont::Problem pb(b, fricont::Storage::Full, b, b);
+            } catch (const fricont::Error &e) {
+                status = e.status();
+            }
+            report(std::string("int32 CSR with ") + what[k] + " throws FRICONT_ERR_CSR", status == FRICONT_ERR_CSR,
+                   std::to_string(status));
+        }
     }
 
     // 9. The monitor (reference: the C interface's events of the same path, unmonitored):

@@ -13,8 +13,10 @@
  *  - Handles: fricont_X_new*(..., fricont_X **out) creates, fricont_X_free(X) frees
  *    (NULL is a no-op). Input arrays are only read during the call and are copied.
  *    Outputs go to caller-owned buffers with explicit lengths.
- *  - Indices: CSR arrays use int64_t with an index_base of 0 (C) or 1 (Fortran);
- *    everything the library returns (event.node, piece and event numbers) is 0-based.
+ *  - Indices: CSR arrays use int64_t (fricont_csr) or int32_t (fricont_csr_i32 with the
+ *    _i32 constructors) with an index_base of 0 (C) or 1 (Fortran); duplicate entries
+ *    are summed. Everything the library returns (event.node, piece and event numbers)
+ *    is 0-based.
  *    Reports (the fricont CLI, the paper) count contact nodes from 1.
  *  - Signs and units: lambda_n <= 0 is compressive; (N u)_i <= g_i is non-penetration;
  *    slip+ slips with T u > 0 and carries lambda_t = F lambda_n. Forces are in the units
@@ -130,12 +132,14 @@ enum fricont_status
     FRICONT_ERR_UNAVAILABLE = -105,
     /**
      * Data: a malformed CSR matrix (index base not 0 or 1, row pointer not starting at
-     * the base or decreasing or not ending at the base + nnz, column out of range,
-     * duplicate entry in a row, an entry of A in the wrong triangle for the storage).
+     * the base or decreasing or not ending at the base + nnz, a column index out of
+     * range or negative, an entry of A in the wrong triangle for the storage; duplicate
+     * entries are not an error: they are summed).
      */
     FRICONT_ERR_CSR = -201,
     /**
-     * Data: a NaN or infinite value in A, N, T, the gap, a guess or a load vector.
+     * Data: a NaN or infinite value in A, N, T (also duplicates whose sum overflows), the
+     * gap, a guess or a load vector.
      */
     FRICONT_ERR_NONFINITE = -202,
     /**
@@ -345,13 +349,18 @@ typedef struct fricont_path fricont_path;
 typedef struct fricont_problem fricont_problem;
 
 /**
- * A sparse matrix in compressed sparse row (CSR) form, as the caller stores it. The
- * library only reads it during the call that receives it and copies what it needs.
+ * A sparse matrix in compressed sparse row (CSR) form with `int64_t` indices, as the
+ * caller stores it. The library only reads it during the call that receives it and
+ * copies what it needs. For `int32_t` indices (PETSc's default `PetscInt`, Eigen, the
+ * int API of CHOLMOD, scipy) use `fricont_csr_i32` with the `_i32` constructors.
  *
  * Row `i` (0-based position) holds the entries `row_ptr[i] - index_base ..
  * row_ptr[i+1] - index_base` (0-based positions in `col_idx` and `values`); the column
  * numbers in `col_idx` count from `index_base` too. Within a row the columns may come in
- * any order but must not repeat (duplicates are rejected, not summed).
+ * any order and may repeat: **duplicate entries are summed** (in the order given), as
+ * scipy, MATLAB's `sparse`, Eigen's `setFromTriplets` and PETSc's `ADD_VALUES` do; the
+ * checks of A (symmetry in full storage, positive definiteness) apply to the summed
+ * matrix.
  */
 typedef struct fricont_csr {
     /**
@@ -384,6 +393,47 @@ typedef struct fricont_csr {
      */
     int64_t index_base;
 } fricont_csr;
+
+/**
+ * A sparse matrix in CSR form with `int32_t` row pointers and column indices: the same
+ * layout and rules as `fricont_csr` (index base, unsorted columns, duplicates summed),
+ * for callers whose matrices hold 32-bit indices, passed to `fricont_problem_new_i32`
+ * and `fricont_problem_new_solve_i32` without a copy on the caller's side (the library
+ * copies during the call, as for `fricont_csr`). The sizes stay `int64_t`; `nnz` and
+ * every row pointer must fit in `int32_t` (they do when the arrays are `int32_t`).
+ * A negative row pointer or column index is `FRICONT_ERR_CSR`, as with 64-bit indices.
+ */
+typedef struct fricont_csr_i32 {
+    /**
+     * Number of rows, ≥ 0.
+     */
+    int64_t nrows;
+    /**
+     * Number of columns, ≥ 0.
+     */
+    int64_t ncols;
+    /**
+     * Number of stored entries: the length of `col_idx` and `values`, and
+     * `row_ptr[nrows] - index_base`.
+     */
+    int64_t nnz;
+    /**
+     * `nrows + 1` row pointers, `row_ptr[0] == index_base`, non-decreasing.
+     */
+    const int32_t *row_ptr;
+    /**
+     * `nnz` column indices (NULL allowed when `nnz == 0`).
+     */
+    const int32_t *col_idx;
+    /**
+     * `nnz` values (NULL allowed when `nnz == 0`), finite.
+     */
+    const double *values;
+    /**
+     * 0 (C) or 1 (Fortran, MATLAB).
+     */
+    int64_t index_base;
+} fricont_csr_i32;
 
 /**
  * The host's solve with its stiffness A (see `fricont_problem_new_solve`): overwrite
@@ -705,6 +755,25 @@ fricont_status fricont_problem_new(const struct fricont_csr *a,
                                    struct fricont_problem **out);
 
 /**
+ * `fricont_problem_new` for CSR matrices with `int32_t` indices (`fricont_csr_i32`):
+ * the same arguments, checks, defaults, ownership (the arrays are read during the call
+ * and copied) and statuses. A, N and T all use 32-bit indices.
+ *
+ * Returns `FRICONT_OK`; `FRICONT_ERR_NULL`; `FRICONT_ERR_LENGTH`; `FRICONT_ERR_RANGE`;
+ * `FRICONT_ERR_CSR` (malformed CSR: a negative or decreasing row pointer, a column index
+ * out of range or negative, index base not 0/1); `FRICONT_ERR_NONFINITE`;
+ * `FRICONT_ERR_PANIC`, as `fricont_problem_new`.
+ *
+ * # Safety
+ * As for `fricont_problem_new`.
+ */
+fricont_status fricont_problem_new_i32(const struct fricont_csr_i32 *a,
+                                       int32_t a_storage,
+                                       const struct fricont_csr_i32 *n,
+                                       const struct fricont_csr_i32 *t,
+                                       struct fricont_problem **out);
+
+/**
  * Creates a problem from condensed data: the Delassus operator W = B A⁻¹ Bᵀ of the
  * caller's stiffness A and contact matrices B = [N; T] (for example the Schur complement
  * a distributed direct solver computes, see the README's "Distributed hosts"). fricont
@@ -782,6 +851,26 @@ fricont_status fricont_problem_new_solve(int64_t n,
                                          const struct fricont_csr *nmat,
                                          const struct fricont_csr *tmat,
                                          struct fricont_problem **out);
+
+/**
+ * `fricont_problem_new_solve` for N and T with `int32_t` indices (`fricont_csr_i32`):
+ * the same arguments, solve contract, finalizer rule (`free_user` is called exactly once,
+ * at once if this function fails), ownership and statuses.
+ *
+ * Returns `FRICONT_OK`; `FRICONT_ERR_NULL`; `FRICONT_ERR_LENGTH`; `FRICONT_ERR_CSR`;
+ * `FRICONT_ERR_NONFINITE`; `FRICONT_ERR_PANIC`, as `fricont_problem_new_solve`.
+ *
+ * # Safety
+ * As for `fricont_problem_new_solve`.
+ */
+fricont_status fricont_problem_new_solve_i32(int64_t n,
+                                             fricont_solve_fn solve,
+                                             void *user,
+                                             fricont_free_fn free_user,
+                                             int64_t max_block,
+                                             const struct fricont_csr_i32 *nmat,
+                                             const struct fricont_csr_i32 *tmat,
+                                             struct fricont_problem **out);
 
 /**
  * Frees a problem handle. NULL is a no-op. Paths created from it stay valid (they hold

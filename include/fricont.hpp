@@ -11,7 +11,8 @@
 //   (`Path::set_monitor`) is wrapped the same way: an exception it throws stops the path
 //   (`EndReason::Stopped`) and is rethrown by `Path::run`.
 // * Indices are those of the C interface: 0-based nodes, events and pieces; CSR input
-//   takes an `index_base` of 0 or 1.
+//   (`CsrRef` with int64_t indices, `CsrRef32` with int32_t ones) takes an `index_base`
+//   of 0 or 1, and sums duplicate entries.
 //
 // Link as for the C interface (`pkg-config --cflags --libs fricont`, or CMake
 // `find_package(fricont)` and `target_link_libraries(app fricont::fricont)`).
@@ -27,6 +28,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -100,36 +102,54 @@ inline std::string name(EndReason r) {
 /// The library's run-time version "MAJOR.MINOR.PATCH".
 inline std::string version() { return fricont_version(); }
 
-/// A borrowed CSR matrix: the caller's arrays, read (and copied by the library) only
-/// during the call that receives it.
-struct CsrRef {
+namespace detail {
+/// The C struct of a CSR view with `Index` indices.
+template <class Index> struct CsrC;
+template <> struct CsrC<int64_t> { using type = fricont_csr; };
+template <> struct CsrC<int32_t> { using type = fricont_csr_i32; };
+}  // namespace detail
+
+/// A borrowed CSR matrix with `int64_t` (`CsrRef`) or `int32_t` (`CsrRef32`) indices: the
+/// caller's arrays, read (and copied by the library) only during the call that receives
+/// it, so 32-bit index arrays are used as they are, without a copy on the caller's side.
+/// Columns may be unsorted and may repeat within a row (duplicates are summed).
+template <class Index> struct BasicCsrRef {
+    static_assert(std::is_same<Index, int64_t>::value || std::is_same<Index, int32_t>::value,
+                  "fricont CSR indices are int64_t or int32_t");
     int64_t nrows = 0;
     int64_t ncols = 0;
-    const int64_t *row_ptr = nullptr;  ///< nrows + 1 entries
-    const int64_t *col_idx = nullptr;  ///< nnz entries
-    const double *values = nullptr;    ///< nnz entries
-    int64_t index_base = 0;            ///< 0 or 1
+    const Index *row_ptr = nullptr;  ///< nrows + 1 entries
+    const Index *col_idx = nullptr;  ///< nnz entries
+    const double *values = nullptr;  ///< nnz entries
+    int64_t index_base = 0;          ///< 0 or 1
 
-    CsrRef() = default;
+    BasicCsrRef() = default;
     /// From vectors (nnz = col_idx.size()).
-    CsrRef(int64_t rows, int64_t cols, const std::vector<int64_t> &ptr,
-           const std::vector<int64_t> &idx, const std::vector<double> &vals, int64_t base = 0)
+    BasicCsrRef(int64_t rows, int64_t cols, const std::vector<Index> &ptr,
+                const std::vector<Index> &idx, const std::vector<double> &vals,
+                int64_t base = 0)
         : nrows(rows), ncols(cols), row_ptr(ptr.data()), col_idx(idx.data()),
           values(vals.data()), index_base(base), nnz_(static_cast<int64_t>(idx.size())) {}
     /// From raw arrays of `nnz` entries.
-    CsrRef(int64_t rows, int64_t cols, int64_t nnz, const int64_t *ptr, const int64_t *idx,
-           const double *vals, int64_t base = 0)
+    BasicCsrRef(int64_t rows, int64_t cols, int64_t nnz, const Index *ptr, const Index *idx,
+                const double *vals, int64_t base = 0)
         : nrows(rows), ncols(cols), row_ptr(ptr), col_idx(idx), values(vals),
           index_base(base), nnz_(nnz) {}
 
-    /// The C view.
-    fricont_csr c() const {
-        return fricont_csr{nrows, ncols, nnz_, row_ptr, col_idx, values, index_base};
+    /// The C view (`fricont_csr` or `fricont_csr_i32`).
+    typename detail::CsrC<Index>::type c() const {
+        return {nrows, ncols, nnz_, row_ptr, col_idx, values, index_base};
     }
 
 private:
     int64_t nnz_ = 0;
 };
+
+/// CSR with `int64_t` indices (`fricont_csr`).
+using CsrRef = BasicCsrRef<int64_t>;
+/// CSR with `int32_t` indices (`fricont_csr_i32`): PETSc's default, Eigen, CHOLMOD's int
+/// API, scipy.
+using CsrRef32 = BasicCsrRef<int32_t>;
 
 /// One node changing class (C++ copy of `fricont_event`; 0-based index, node).
 struct Event {
@@ -272,6 +292,12 @@ public:
         fricont_csr ca = a.c(), cn = n.c(), ct = t.c();
         detail::check(fricont_problem_new(&ca, static_cast<int32_t>(storage), &cn, &ct, &h_));
     }
+    /// The same with int32_t indices (see `fricont_problem_new_i32`).
+    Problem(const CsrRef32 &a, Storage storage, const CsrRef32 &n, const CsrRef32 &t) {
+        fricont_csr_i32 ca = a.c(), cn = n.c(), ct = t.c();
+        detail::check(
+            fricont_problem_new_i32(&ca, static_cast<int32_t>(storage), &cn, &ct, &h_));
+    }
     /// From condensed data (see `fricont_problem_new_condensed`): W = B A⁻¹ Bᵀ, 2p × 2p,
     /// column-major (`w.size() == 4p²`), symmetric positive definite. Loads are then
     /// condensed vectors of 2p entries; states carry no u (`State::u` stays empty) and
@@ -304,6 +330,19 @@ public:
         detail::check(fricont_problem_new_solve(n, &Problem::solve_trampoline, ctx,
                                                 &Problem::solve_free, max_block, &cn, &ct,
                                                 &prob.h_));
+        return prob;
+    }
+    /// The same with int32_t indices in N and T (see `fricont_problem_new_solve_i32`).
+    static Problem with_solve(int64_t n, SolveFn solve, const CsrRef32 &nm, const CsrRef32 &t,
+                              int64_t max_block = 64) {
+        if (!solve) throw Error(FRICONT_ERR_NULL, "fricont::Problem::with_solve: no solve");
+        auto *ctx = new SolveFn(std::move(solve));
+        fricont_csr_i32 cn = nm.c(), ct = t.c();
+        Problem prob;
+        // The library owns ctx from here: it calls the finalizer (also on failure).
+        detail::check(fricont_problem_new_solve_i32(n, &Problem::solve_trampoline, ctx,
+                                                    &Problem::solve_free, max_block, &cn, &ct,
+                                                    &prob.h_));
         return prob;
     }
 

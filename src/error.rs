@@ -20,12 +20,15 @@ pub enum Error {
     /// W formed by a host's solve. The message names the matrix and the entries.
     #[error("{0}")]
     NotSymmetric(String),
-    /// The Cholesky factorisation of A met a non-positive pivot.
+    /// The Cholesky factorisation of A met a non-positive pivot. The fields count from 0
+    /// (as every index of the API); the message counts from 1, as every message does.
     #[error(
-        "A is not positive definite: non-positive pivot at (0-based) position {pivot} of the fill-reducing ordering, original row {row}"
+        "A is not positive definite: non-positive pivot in row {} of A (1-based; pivot {} of the fill-reducing ordering)",
+        row + 1,
+        pivot + 1
     )]
     NotSpd {
-        /// Pivot position in the permuted order.
+        /// Pivot position in the permuted order (0-based).
         pivot: usize,
         /// Row of A (0-based) that the pivot belongs to.
         row: usize,

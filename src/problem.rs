@@ -11,7 +11,7 @@ use faer::Mat;
 
 /// A sparse matrix in compressed sparse row form, 0-based, validated: row pointers start
 /// at 0 and do not decrease, column indices are in range, sorted and unique within each
-/// row, values are finite.
+/// row (the constructors sum duplicate entries), values are finite.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CsrMatrix {
     nrows: usize,
@@ -22,24 +22,27 @@ pub struct CsrMatrix {
 }
 
 impl CsrMatrix {
-    /// Validates and copies a CSR matrix given with signed 64-bit indices and an index base
-    /// of 0 (C) or 1 (Fortran, MATLAB).
+    /// Validates and copies a CSR matrix given with signed indices (`i64` or `i32`, as the
+    /// caller stores them: no conversion on the caller's side) and an index base of 0 (C)
+    /// or 1 (Fortran, MATLAB).
     ///
     /// `row_ptr` has `nrows + 1` entries with `row_ptr[0] == index_base`; the entries of row
     /// `i` are `row_ptr[i] - base .. row_ptr[i+1] - base`. Within a row, columns may come in
-    /// any order (they are sorted here) but must not repeat: **duplicate entries are
-    /// rejected**, not summed, because a duplicate in assembled CSR is almost always a bug in
-    /// the caller's assembly. `name` is used in error messages ("A", "N", "T").
+    /// any order (they are sorted here) and may repeat: **duplicate entries are summed**, in
+    /// the order they are given (the assembly convention of scipy, MATLAB's `sparse`,
+    /// Eigen's `setFromTriplets` and PETSc's `ADD_VALUES`, and of Matrix Market files).
+    /// Every later check (symmetry of A in full storage, positive definiteness) sees the
+    /// summed matrix. `name` is used in error messages ("A", "N", "T").
     ///
     /// Errors: [`Error::Csr`] for a bad index base, row pointer (length, start, decrease,
-    /// end ≠ number of values), column index out of range, duplicate; [`Error::NonFinite`]
-    /// for a NaN or infinite value.
-    pub fn from_raw(
+    /// end ≠ number of values), column index out of range; [`Error::NonFinite`] for a NaN or
+    /// infinite value, or duplicates whose sum overflows to infinity.
+    pub fn from_raw<I: Copy + Into<i64>>(
         name: &str,
         nrows: usize,
         ncols: usize,
-        row_ptr: &[i64],
-        col_idx: &[i64],
+        row_ptr: &[I],
+        col_idx: &[I],
         values: &[f64],
         index_base: i64,
     ) -> Result<Self> {
@@ -62,23 +65,25 @@ impl CsrMatrix {
                 values.len()
             )));
         }
-        if row_ptr[0] != index_base {
+        let first: i64 = row_ptr[0].into();
+        if first != index_base {
             return Err(Error::Csr(format!(
-                "{name} (CSR): row_ptr[0] = {}, expected the index base {index_base}",
-                row_ptr[0]
+                "{name} (CSR): row_ptr[0] = {first}, expected the index base {index_base}"
             )));
         }
         let nnz = values.len();
         let mut rp = try_with_capacity(nrows + 1, &format!("{name}: row pointers"))?;
-        for (i, &r) in row_ptr.iter().enumerate() {
+        let mut prev = first;
+        for (i, r) in row_ptr.iter().enumerate() {
+            let r: i64 = (*r).into();
             // saturating: i64::MIN - 1 must be "out of range", not an overflow
             let r0 = r.saturating_sub(index_base);
-            if i > 0 && r < row_ptr[i - 1] {
+            if i > 0 && r < prev {
                 return Err(Error::Csr(format!(
                     "{name} (CSR): row pointer decreases at row {} ({} after {})",
                     i - 1 + index_base as usize,
                     r,
-                    row_ptr[i - 1]
+                    prev
                 )));
             }
             if r0 < 0 || r0 as u64 > nnz as u64 {
@@ -87,6 +92,7 @@ impl CsrMatrix {
                 )));
             }
             rp.push(r0 as usize);
+            prev = r;
         }
         if rp[nrows] != nnz {
             return Err(Error::Csr(format!(
@@ -95,17 +101,22 @@ impl CsrMatrix {
             )));
         }
         let mut ci = try_with_capacity(nnz, &format!("{name}: column indices"))?;
-        let mut vals = try_with_capacity(nnz, &format!("{name}: values"))?;
+        let mut vals: Vec<f64> = try_with_capacity(nnz, &format!("{name}: values"))?;
         let mut row: Vec<(usize, f64)> = Vec::new();
+        // `rp` is rewritten row by row to the summed structure; `lo` keeps the caller's
+        // start of the next row.
+        let mut lo = rp[0];
         for i in 0..nrows {
+            let hi = rp[i + 1];
             row.clear();
-            for k in rp[i]..rp[i + 1] {
-                let c = col_idx[k].saturating_sub(index_base);
+            for k in lo..hi {
+                let given: i64 = col_idx[k].into();
+                let c = given.saturating_sub(index_base);
                 if c < 0 || c as u64 >= ncols as u64 {
                     return Err(Error::Csr(format!(
                         "{name} (CSR): row {} has column index {} outside {}..{} (ncols {ncols}, index base {index_base})",
                         i as i64 + index_base,
-                        col_idx[k],
+                        given,
                         index_base,
                         (ncols as i64).saturating_add(index_base)
                     )));
@@ -114,26 +125,34 @@ impl CsrMatrix {
                     return Err(Error::NonFinite(format!(
                         "{name}: entry ({}, {}) is {}",
                         i as i64 + index_base,
-                        col_idx[k],
+                        given,
                         values[k]
                     )));
                 }
                 row.push((c as usize, values[k]));
             }
+            // Stable: duplicates are summed in the order the caller gave them.
             row.sort_by_key(|e| e.0);
-            for w in row.windows(2) {
-                if w[0].0 == w[1].0 {
-                    return Err(Error::Csr(format!(
-                        "{name} (CSR): row {} has a duplicate entry in column {} (duplicates are rejected, not summed)",
-                        i as i64 + index_base,
-                        w[0].0 as i64 + index_base
-                    )));
+            let row_start = ci.len();
+            for &(c, v) in &row {
+                if ci.len() > row_start && ci.last() == Some(&c) {
+                    let s = vals.last_mut().expect("a value per column index");
+                    *s += v;
+                    if !s.is_finite() {
+                        return Err(Error::NonFinite(format!(
+                            "{name}: the duplicate entries ({}, {}) sum to {}",
+                            i as i64 + index_base,
+                            c as i64 + index_base,
+                            *s
+                        )));
+                    }
+                } else {
+                    ci.push(c);
+                    vals.push(v);
                 }
             }
-            for &(c, v) in &row {
-                ci.push(c);
-                vals.push(v);
-            }
+            rp[i + 1] = ci.len();
+            lo = hi;
         }
         Ok(Self {
             nrows,
@@ -145,8 +164,9 @@ impl CsrMatrix {
     }
 
     /// Builds a CSR matrix from 0-based triplets `(row, col, value)`; duplicates are
-    /// **summed** here (this is the assembly entry point, as in Matrix Market files).
-    /// Errors: indices out of range, non-finite values.
+    /// **summed** (in the order given), as by [`CsrMatrix::from_raw`] and in Matrix Market
+    /// files. Errors: [`Error::Csr`] for indices out of range, [`Error::NonFinite`] for
+    /// non-finite values or duplicates whose sum overflows.
     pub fn from_triplets(
         name: &str,
         nrows: usize,
@@ -179,7 +199,16 @@ impl CsrMatrix {
         let mut last: Option<(usize, usize)> = None;
         for (i, j, v) in t {
             if last == Some((i, j)) {
-                *values.last_mut().unwrap() += v;
+                let s = values.last_mut().expect("a value per entry");
+                *s += v;
+                if !s.is_finite() {
+                    return Err(Error::NonFinite(format!(
+                        "{name}: the duplicate entries ({}, {}) (1-based) sum to {}",
+                        i + 1,
+                        j + 1,
+                        *s
+                    )));
+                }
             } else {
                 col_idx.push(j);
                 values.push(v);

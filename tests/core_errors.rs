@@ -143,10 +143,6 @@ fn csr_structure_errors() {
             raw_err("col base", 2, 2, &[1, 2, 3], &[0, 2], &[1.0, 1.0], 1),
         ),
         (
-            "duplicate",
-            raw_err("dup", 2, 2, &[0, 2, 3], &[1, 1, 1], &[1.0, 1.0, 1.0], 0),
-        ),
-        (
             "col_idx and values lengths",
             raw_err("len", 2, 2, &[0, 1, 2], &[0, 1], &[1.0], 0),
         ),
@@ -154,9 +150,6 @@ fn csr_structure_errors() {
     for (what, e) in cases {
         assert!(matches!(e, Csr(_)), "{what}: {e:?}");
     }
-    // the duplicate message says duplicates are rejected
-    let e = raw_err("dup", 2, 2, &[0, 2, 3], &[1, 1, 1], &[1.0, 1.0, 1.0], 0);
-    assert!(e.to_string().contains("duplicate"), "{e}");
     // triplets out of range
     let e = no_panic("triplets", || {
         CsrMatrix::from_triplets("N", 1, 3, &[(0, 3, 1.0)])
@@ -376,6 +369,9 @@ fn not_positive_definite_reports_the_pivot() {
             Error::NotSpd { row, pivot } => {
                 assert_eq!(row, k, "{e}");
                 assert!(pivot < 4);
+                // the message counts from 1, as every message does
+                let m = e.to_string();
+                assert!(m.contains(&format!("row {} of A (1-based", k + 1)), "{m}");
             }
             e => panic!("diag({bad}): {e:?}"),
         }
@@ -731,6 +727,110 @@ fn csr_extreme_indices_are_errors_not_overflows() {
         // a first row pointer of i64::MAX
         let e = CsrMatrix::from_raw("M", 1, 2, &[i64::MAX, i64::MAX], &[], &[], base);
         assert!(matches!(e, Err(Error::Csr(_))), "base {base}: {e:?}");
+    }
+}
+
+/// Duplicate entries in CSR input are summed, in the order given, with 64-bit and
+/// 32-bit indices, unsorted or not; a sum that overflows is a non-finite error.
+#[test]
+fn csr_duplicates_are_summed() {
+    // Row 0: (0, 1) given as 0.25 then 0.5, (0, 0) once; row 1: (1, 1) as 1, 2, 4.
+    let expect = dense(2, 2, &[3.0, 0.75, 0.0, 7.0]);
+    let m64 = CsrMatrix::from_raw(
+        "A",
+        2,
+        2,
+        &[0i64, 3, 6],
+        &[1, 0, 1, 1, 1, 1],
+        &[0.25, 3.0, 0.5, 1.0, 2.0, 4.0],
+        0,
+    )
+    .unwrap();
+    assert_eq!(m64, expect);
+    assert_eq!(m64.nnz(), 3);
+    let m32 = CsrMatrix::from_raw(
+        "A",
+        2,
+        2,
+        &[1i32, 4, 7],
+        &[2, 1, 2, 2, 2, 2],
+        &[0.25, 3.0, 0.5, 1.0, 2.0, 4.0],
+        1,
+    )
+    .unwrap();
+    assert_eq!(m32, expect);
+    // Summation order is the caller's: 1 + 1e16 − 1e16 = 0 in that order (1 is absorbed),
+    // 1e16 − 1e16 + 1 = 1 in the other.
+    let m = CsrMatrix::from_raw("A", 1, 1, &[0, 3], &[0, 0, 0], &[1.0, 1e16, -1e16], 0).unwrap();
+    assert_eq!(m.values(), &[0.0]);
+    let m = CsrMatrix::from_raw("A", 1, 1, &[0, 3], &[0, 0, 0], &[1e16, -1e16, 1.0], 0).unwrap();
+    assert_eq!(m.values(), &[1.0]);
+    // Overflow of a sum: an error naming the entry, not an infinity in the matrix.
+    let e = CsrMatrix::from_raw("A", 1, 2, &[0, 2], &[1, 1], &[1e308, 1e308], 0).unwrap_err();
+    assert!(matches!(e, Error::NonFinite(_)), "{e:?}");
+    assert!(e.to_string().contains("(0, 1)"), "{e}");
+    let e = CsrMatrix::from_triplets("N", 1, 2, &[(0, 1, -1e308), (0, 1, -1e308)]).unwrap_err();
+    assert!(matches!(e, Error::NonFinite(_)), "{e:?}");
+}
+
+/// The symmetry check of A in full storage applies to the summed matrix: A(0, 1) given as
+/// 0.25 + 0.25 matches A(1, 0) = 0.5, while 0.5 + 0.5 does not.
+#[test]
+fn symmetry_check_sees_summed_duplicates() {
+    let a = |x: f64| {
+        CsrMatrix::from_raw(
+            "A",
+            3,
+            3,
+            &[0i64, 3, 5, 6],
+            &[0, 1, 1, 0, 1, 2],
+            &[4.0, x, x, 0.5, 4.0, 4.0],
+            0,
+        )
+        .unwrap()
+    };
+    let nm = dense(1, 3, &[0.0, 0.0, 1.0]);
+    let tm = dense(1, 3, &[1.0, 0.0, 0.0]);
+    // summed: A = [[4, 0.5, 0], [0.5, 4, 0], [0, 0, 4]], symmetric, positive definite
+    let p = ProblemBuilder::new(a(0.25), Storage::Full, nm.clone(), tm.clone())
+        .build()
+        .unwrap();
+    let same = ProblemBuilder::new(
+        dense(3, 3, &[4.0, 0.5, 0.0, 0.5, 4.0, 0.0, 0.0, 0.0, 4.0]),
+        Storage::Full,
+        nm.clone(),
+        tm.clone(),
+    )
+    .build()
+    .unwrap();
+    assert_eq!(p.default_r(), same.default_r());
+    let e = build_err(
+        "A(0,1) summed to 1, A(1,0) = 0.5",
+        ProblemBuilder::new(a(0.5), Storage::Full, nm, tm),
+    );
+    assert!(matches!(e, Error::NotSymmetric(_)), "{e:?}");
+}
+
+/// Extreme or negative int32 indices are CSR errors too.
+#[test]
+fn csr_i32_bad_indices_are_errors() {
+    for base in [0i32, 1] {
+        let b = i64::from(base);
+        let e = CsrMatrix::from_raw("M", 1, 2, &[base, i32::MIN], &[base], &[1.0], b);
+        assert!(matches!(e, Err(Error::Csr(_))), "base {base}: {e:?}");
+        for c in [i32::MIN, -1, i32::MAX] {
+            let e = CsrMatrix::from_raw("M", 1, 2, &[base, base + 1], &[c], &[1.0], b);
+            assert!(
+                matches!(e, Err(Error::Csr(_))),
+                "base {base}, column {c}: {e:?}"
+            );
+        }
+        // a decreasing row pointer
+        let e = CsrMatrix::from_raw("M", 2, 2, &[base, base + 1, base], &[base], &[1.0], b);
+        assert!(
+            matches!(&e, Err(Error::Csr(m)) if m.contains("decreases")),
+            "{e:?}"
+        );
     }
 }
 

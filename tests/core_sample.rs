@@ -326,3 +326,98 @@ fn sample_rect30_transition_points_precise() {
         failures.join("\n")
     );
 }
+
+/// The sample's A, N and T handed over as a caller's raw CSR with **duplicate entries**
+/// (every value split into two parts, the rows' entries in reverse order), with 64-bit and
+/// with 32-bit indices, 0- and 1-based: the library sums the parts (in the order given),
+/// and the path is that of the summed matrices, bit for bit. The summed reference is made
+/// here by adding the same two parts, so the two inputs hold the same numbers.
+#[test]
+fn sample_duplicates_and_int32_indices_give_the_events_of_the_summed_matrices() {
+    let dir = sample_dir();
+    let (n, _, ta) = read_mtx(&dir.join("A.mtx"));
+    let (p, _, tn) = read_mtx(&dir.join("N.mtx"));
+    let (_, _, tt) = read_mtx(&dir.join("T.mtx"));
+    let s = load_sample(&dir);
+    let fr = s.data.friction.clone();
+    let gap = s.data.gap.clone();
+    let split = |v: f64| (0.375 * v, v - 0.375 * v);
+    // Summed reference: triplets with the value a + b of the two parts.
+    let summed = |name: &str, r: usize, t: &[(usize, usize, f64)]| {
+        let t2: Vec<(usize, usize, f64)> = t
+            .iter()
+            .map(|&(i, j, v)| {
+                let (a, b) = split(v);
+                (i, j, a + b)
+            })
+            .collect();
+        CsrMatrix::from_triplets(name, r, n, &t2).unwrap()
+    };
+    // Raw CSR with each entry as two, in reverse order within the row (part a first).
+    fn raw<I: TryFrom<i64> + Copy + Into<i64>>(
+        rows: usize,
+        t: &[(usize, usize, f64)],
+        base: i64,
+        split: impl Fn(f64) -> (f64, f64),
+    ) -> (Vec<I>, Vec<I>, Vec<f64>) {
+        let conv = |x: i64| I::try_from(x).ok().expect("index fits");
+        let mut by_row: Vec<Vec<(usize, f64)>> = vec![Vec::new(); rows];
+        for &(i, j, v) in t {
+            by_row[i].push((j, v));
+        }
+        let (mut rp, mut ci, mut vals) = (vec![conv(base)], Vec::new(), Vec::new());
+        for row in &by_row {
+            // part a of every entry (reverse order), then part b of every entry
+            for &(j, v) in row.iter().rev() {
+                ci.push(conv(j as i64 + base));
+                vals.push(split(v).0);
+            }
+            for &(j, v) in row {
+                ci.push(conv(j as i64 + base));
+                vals.push(split(v).1);
+            }
+            rp.push(conv(ci.len() as i64 + base));
+        }
+        (rp, ci, vals)
+    }
+    let events = |a: CsrMatrix, nm: CsrMatrix, tm: CsrMatrix| {
+        let problem = ProblemBuilder::new(a, Storage::Full, nm, tm)
+            .friction(fr.clone())
+            .gap(gap.clone())
+            .build()
+            .unwrap();
+        let path = trace(Arc::new(problem), s.data.affine_load(), s.a0, s.a1);
+        assert_eq!(path.end_reason(), Some(&EndReason::Window));
+        path.events()
+            .iter()
+            .map(|e| (e.alpha.to_bits(), e.node, e.from, e.to, e.fold))
+            .collect::<Vec<_>>()
+    };
+    let reference = events(
+        summed("A", n, &ta),
+        summed("N", p, &tn),
+        summed("T", p, &tt),
+    );
+    assert!(!reference.is_empty());
+    for base in [0i64, 1] {
+        let (ra, ca, va) = raw::<i64>(n, &ta, base, split);
+        let (rn, cn, vn) = raw::<i64>(p, &tn, base, split);
+        let (rt, ct, vt) = raw::<i64>(p, &tt, base, split);
+        assert_eq!(va.len(), 2 * ta.len(), "every entry of A is given twice");
+        let got = events(
+            CsrMatrix::from_raw("A", n, n, &ra, &ca, &va, base).unwrap(),
+            CsrMatrix::from_raw("N", p, n, &rn, &cn, &vn, base).unwrap(),
+            CsrMatrix::from_raw("T", p, n, &rt, &ct, &vt, base).unwrap(),
+        );
+        assert_eq!(got, reference, "int64, base {base}");
+        let (ra, ca, va) = raw::<i32>(n, &ta, base, split);
+        let (rn, cn, vn) = raw::<i32>(p, &tn, base, split);
+        let (rt, ct, vt) = raw::<i32>(p, &tt, base, split);
+        let got = events(
+            CsrMatrix::from_raw("A", n, n, &ra, &ca, &va, base).unwrap(),
+            CsrMatrix::from_raw("N", p, n, &rn, &cn, &vn, base).unwrap(),
+            CsrMatrix::from_raw("T", p, n, &rt, &ct, &vt, base).unwrap(),
+        );
+        assert_eq!(got, reference, "int32, base {base}");
+    }
+}

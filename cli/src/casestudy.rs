@@ -1259,7 +1259,7 @@ fn header(spec: &RectSpec, end: &EndReason, path: &Path) -> String {
     let tp = path.events().last().map_or(0, |e| e.transition + 1);
     format!(
         "{}\nn = {}, p = {}, E = {}, nu = {}, F = {}, load \"{}\"\n\
-         traced alpha from {} to {}: {} transition points ({} events, {} folds), ended by \"{}\" at alpha = {}\n",
+         traced alpha from {} to {}: {} ({}, {}), ended by \"{}\" at alpha = {}\n",
         spec.mesh_description(),
         spec.n(),
         spec.p(),
@@ -1269,9 +1269,9 @@ fn header(spec: &RectSpec, end: &EndReason, path: &Path) -> String {
         spec.load_name,
         spec.alpha_start,
         spec.alpha_end,
-        tp,
-        path.events().len(),
-        folds,
+        fricont_exchange::report::plural(tp, "transition point"),
+        fricont_exchange::report::plural(path.events().len(), "event"),
+        fricont_exchange::report::plural(folds, "fold"),
         end.name(),
         fmt_alpha(last)
     )

@@ -1,27 +1,33 @@
 //! `fricont`: the command-line front end.
 //!
 //! ```text
-//! fricont trace DIR [--alpha-start A] [--alpha-end B] [--r R] [--max-steps K] [--threads N] [--json FILE]
+//! fricont trace DIR [--alpha-start A] [--alpha-end B] [--r R] [--max-steps K] [--threads N]
+//!                   [--json FILE] [--progress]
 //! ```
 //!
-//! reads a problem directory in the exchange format (SPEC §7), traces the path, prints the
-//! transition table (α with 14 significant digits, 1-based nodes) and the set-up/trace
-//! times, and writes the JSON of SPEC §8.
+//! reads a problem directory in the exchange format (`docs/exchange-format.md`), traces
+//! the path, prints the transition table (α with 14 significant digits, 1-based nodes) and
+//! the set-up/trace times, and writes the JSON report of `docs/json-report.md`. While it
+//! works it shows its progress on stderr (the phase, then α's position in the window,
+//! the transition points so far and the elapsed time, a few updates a second) when
+//! stderr is a terminal or `--progress` is given.
 //!
 //! Exit status: 0 when the path was traced (whatever its end reason except `failed`);
 //! 2 for bad input (unreadable or malformed files, data the problem builder rejects,
-//! an invalid window or option; the message is one line on stderr); 1 for a failure at
-//! run time (the start solve or a step failed, the JSON could not be written). On a
+//! an invalid window or option, a `--json` file that cannot be written — checked before
+//! anything is read; the message is one line on stderr); 1 for a failure at run time
+//! (the start solve or a step failed, the JSON could not be written at the end). On a
 //! failure during tracing, what was traced is still printed and written.
 
-use std::path::PathBuf;
+use std::io::{IsTerminal as _, Write as _};
+use std::path::{Path as FsPath, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use clap::{Parser, Subcommand};
 
-use fricont::path::{Path, PathOptions};
+use fricont::path::{Path, PathOptions, StepOutcome};
 use fricont_exchange::io::CaseData;
 use fricont_exchange::report::{self, Timing};
 
@@ -35,7 +41,11 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Trace the solution path of a problem directory (SPEC §7 exchange format).
+    /// Trace the solution path of a problem directory.
+    ///
+    /// The directory format (files, Matrix Market variants, duplicates, gzip, meta.json) is
+    /// specified in docs/exchange-format.md, every key of the JSON report (--json) in
+    /// docs/json-report.md.
     Trace(TraceArgs),
     /// Write a rectangle problem (Q1 plane strain, left side clamped, bottom on a rigid
     /// foundation) in the exchange format. Defaults: the case study (31 × 22 nodes).
@@ -58,22 +68,23 @@ struct GenRectArgs {
     #[arg(long)]
     ny: Option<usize>,
     /// Side length along x.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     lx: Option<f64>,
     /// Side length along y.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     ly: Option<f64>,
     /// Young's modulus.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     e: Option<f64>,
     /// Poisson's ratio.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     nu: Option<f64>,
     /// Friction coefficient of every contact node.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     friction: Option<f64>,
-    /// Uniform initial gap.
-    #[arg(long)]
+    /// Uniform initial gap (length units; negative: an initial overlap, which the
+    /// problem allows).
+    #[arg(long, allow_negative_numbers = true)]
     gap: Option<f64>,
     /// Tractions of f0, repeatable: SIDE:TX,TY or SIDE:TX,TY:TX2,TY2 (replaces the default).
     #[arg(long, allow_negative_numbers = true)]
@@ -98,7 +109,8 @@ struct CaseStudyArgs {
 
 #[derive(clap::Args, Debug)]
 struct TraceArgs {
-    /// Problem directory: A.mtx, N.mtx, T.mtx, f0.txt, f1.txt, [gap.txt], meta.json.
+    /// Problem directory: A.mtx, N.mtx, T.mtx, f0.txt, f1.txt, [gap.txt], meta.json (each
+    /// may be gzip-compressed as NAME.gz); see docs/exchange-format.md.
     dir: PathBuf,
     /// Start of the α window (default: `alpha_start` of meta.json).
     #[arg(long, allow_negative_numbers = true)]
@@ -109,16 +121,22 @@ struct TraceArgs {
     /// Augmentation parameter r > 0 (default: 2p / trace W). Does not change the path.
     #[arg(long, allow_negative_numbers = true)]
     r: Option<f64>,
-    /// Stop after this many transition points.
+    /// Stop after this many transition points (at least 1; default 10000).
     #[arg(long)]
     max_steps: Option<usize>,
     /// Threads of the set-up (factorisation of A, forming W), 1..=1024. Results agree
     /// with one thread to rounding; tracing runs on one thread.
     #[arg(long, default_value_t = 1)]
     threads: usize,
-    /// Write the JSON report (SPEC §8) to this file.
+    /// Write the JSON report to this file (every key: docs/json-report.md). The file is
+    /// checked to be writable before anything is read or traced.
     #[arg(long)]
     json: Option<PathBuf>,
+    /// Show progress on stderr (the phase, α's position in the window, transition points
+    /// so far, elapsed time) even when stderr is not a terminal; on a terminal it is shown
+    /// anyway.
+    #[arg(long)]
+    progress: bool,
 }
 
 /// A failure with its exit status.
@@ -141,7 +159,146 @@ fn runtime(msg: impl std::fmt::Display) -> Failure {
     }
 }
 
+/// The file of the JSON report, opened for writing before anything is traced (so a bad
+/// path fails at once). Created here if it did not exist, and removed again when the run
+/// ends without writing it; an existing file is left as it was until the report replaces
+/// it.
+struct JsonOut {
+    path: PathBuf,
+    file: std::fs::File,
+    created: bool,
+    written: bool,
+}
+
+impl JsonOut {
+    fn open(path: &FsPath) -> Result<JsonOut, Failure> {
+        let existed = path.exists();
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(path)
+            .map_err(|e| {
+                input(format!(
+                    "cannot write the JSON report to {}: {e}",
+                    path.display()
+                ))
+            })?;
+        Ok(JsonOut {
+            path: path.to_path_buf(),
+            file,
+            created: !existed,
+            written: false,
+        })
+    }
+
+    fn write(mut self, text: &str) -> Result<(), Failure> {
+        self.written = true;
+        self.file
+            .set_len(0)
+            .and_then(|()| self.file.write_all(text.as_bytes()))
+            .and_then(|()| self.file.flush())
+            .map_err(|e| runtime(format!("cannot write {}: {e}", self.path.display())))
+    }
+}
+
+impl Drop for JsonOut {
+    fn drop(&mut self) {
+        if self.created && !self.written {
+            let _ = std::fs::remove_file(&self.path);
+        }
+    }
+}
+
+/// Progress on stderr: phases as lines, then the tracing state (α's position in the
+/// window, transition points so far, elapsed time), at most every 0.25 s on a terminal
+/// (one line rewritten in place) and every second otherwise (one line each), and a final
+/// line. Silent unless stderr is a terminal or `--progress` was given.
+struct Progress {
+    enabled: bool,
+    tty: bool,
+    t0: Instant,
+    last: Option<Instant>,
+    /// A line is open on the terminal (written with `\r`, not yet ended).
+    open: bool,
+}
+
+impl Progress {
+    fn new(asked: bool) -> Progress {
+        let tty = std::io::stderr().is_terminal();
+        Progress {
+            enabled: asked || tty,
+            tty,
+            t0: Instant::now(),
+            last: None,
+            open: false,
+        }
+    }
+
+    fn line(&mut self, text: &str) {
+        if !self.enabled {
+            return;
+        }
+        let mut err = std::io::stderr().lock();
+        if self.open {
+            let _ = write!(err, "\r\x1b[K");
+            self.open = false;
+        }
+        let _ = writeln!(err, "fricont: {text}");
+    }
+
+    fn phase(&mut self, text: &str) {
+        let t = self.t0.elapsed().as_secs_f64();
+        self.line(&format!("[{t:.1} s] {text}"));
+    }
+
+    /// `[12.5 s] alpha = -0.422888 (4% of [-0.5, 1.5]), 1 transition point`: short
+    /// enough for one line of an 80-column terminal (α to 6 decimals here; the table and
+    /// the report give it to 14 significant digits).
+    fn state(&self, alpha: f64, transitions: usize, window: (f64, f64)) -> String {
+        let frac = (alpha - window.0) / (window.1 - window.0);
+        format!(
+            "[{:.1} s] alpha = {alpha:.6} ({:.0}% of [{}, {}]), {}",
+            self.t0.elapsed().as_secs_f64(),
+            100.0 * frac,
+            window.0,
+            window.1,
+            report::plural(transitions, "transition point")
+        )
+    }
+
+    /// After a step: shown when the last update is old enough.
+    fn update(&mut self, alpha: f64, transitions: usize, window: (f64, f64)) {
+        if !self.enabled {
+            return;
+        }
+        let every = Duration::from_millis(if self.tty { 250 } else { 1000 });
+        let now = Instant::now();
+        if self.last.is_some_and(|t| now.duration_since(t) < every) {
+            return;
+        }
+        self.last = Some(now);
+        let text = self.state(alpha, transitions, window);
+        let mut err = std::io::stderr().lock();
+        if self.tty {
+            let _ = write!(err, "\r\x1b[Kfricont: {text}");
+            let _ = err.flush();
+            self.open = true;
+        } else {
+            let _ = writeln!(err, "fricont: {text}");
+        }
+    }
+}
+
 fn trace(args: &TraceArgs) -> Result<(), Failure> {
+    if args.max_steps == Some(0) {
+        return Err(input(
+            "--max-steps 0: at least one transition point must be allowed (the default is 10000)",
+        ));
+    }
+    let json = args.json.as_deref().map(JsonOut::open).transpose()?;
+    let mut progress = Progress::new(args.progress);
+    progress.phase(&format!("reading {}", args.dir.display()));
     let case = CaseData::read_dir(&args.dir).map_err(input)?;
     let alpha_start = args.alpha_start.unwrap_or(case.alpha_start);
     let alpha_end = args.alpha_end.unwrap_or(case.alpha_end);
@@ -150,6 +307,11 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
         opts.max_steps = k;
     }
 
+    progress.phase(&format!(
+        "set-up: n = {}, p = {}, Cholesky of A and W = B A^-1 B^T",
+        case.n(),
+        case.p()
+    ));
     let t0 = Instant::now();
     let mut builder = case.builder().threads(args.threads);
     if let Some(r) = args.r {
@@ -164,18 +326,44 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
     let mut path = Path::new(Arc::new(problem), load, opts).map_err(input)?;
     let setup_s = t0.elapsed().as_secs_f64();
 
+    progress.phase(&format!(
+        "start: fixed-alpha solve at alpha = {alpha_start}"
+    ));
     let t1 = Instant::now();
     path.start(alpha_start, None)
         .map_err(|e| runtime(format!("start at alpha = {alpha_start}: {e}")))?;
-    let run = path.run();
+    progress.phase(&format!(
+        "tracing from alpha = {alpha_start} toward {alpha_end}"
+    ));
+    let window = (alpha_start, alpha_end);
+    let mut last = (alpha_start, 0usize);
+    let run = loop {
+        match path.step() {
+            Ok(StepOutcome::End(r)) => break Ok(r),
+            Ok(StepOutcome::Transition { events, .. }) => {
+                if let Some(e) = path.events().get(events.end.wrapping_sub(1)) {
+                    last = (e.alpha, e.transition + 1);
+                    progress.update(last.0, last.1, window);
+                }
+            }
+            Err(e) => break Err(e),
+        }
+    };
     let trace_s = t1.elapsed().as_secs_f64();
     let timing = Timing { setup_s, trace_s };
+    if progress.enabled {
+        let end_alpha = match &run {
+            Ok(fricont::EndReason::Window) => alpha_end,
+            _ => last.0,
+        };
+        let text = progress.state(end_alpha, last.1, window);
+        progress.line(&format!("{text}; done"));
+    }
 
     print!("{}", report::table(&mut path, Some(timing)));
-    if let Some(file) = &args.json {
+    if let Some(out) = json {
         let text = report::PathReport::from_path(&mut path, timing).to_json_string();
-        std::fs::write(file, text)
-            .map_err(|e| runtime(format!("cannot write {}: {e}", file.display())))?;
+        out.write(&text)?;
     }
     match run {
         Ok(fricont::EndReason::Failed(m)) => Err(runtime(format!("path failed: {m}"))),

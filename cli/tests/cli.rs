@@ -551,7 +551,24 @@ fn broken_matrix_market_files() {
     expect_input_error(
         "A.mtx",
         Some("%%MatrixMarket matrix array real general\n4 4\n"),
-        &["A.mtx:1:", "bad header"],
+        &["A.mtx:2:", "only 0 values, expected 16 values"],
+    );
+    expect_input_error(
+        "A.mtx",
+        Some("%%MatrixMarket matrix coordinate pattern symmetric\n4 4 4\n1 1\n2 2\n3 3\n4 4\n"),
+        &["A.mtx:1:", "\"pattern\" is not supported"],
+    );
+    expect_input_error(
+        "N.mtx",
+        Some("%%MatrixMarket matrix coordinate complex general\n2 4 2\n1 1 1 0\n2 3 1 0\n"),
+        &["N.mtx:1:", "\"complex\" is not supported"],
+    );
+    expect_input_error(
+        "A.mtx",
+        Some(
+            "%%MatrixMarket matrix coordinate real hermitian\n4 4 4\n1 1 2\n2 2 3\n3 3 5\n4 4 4\n",
+        ),
+        &["A.mtx:1:", "\"hermitian\" is not supported"],
     );
     expect_input_error(
         "N.mtx",
@@ -607,11 +624,12 @@ fn broken_vectors_and_meta() {
 
 #[test]
 fn data_rejected_by_the_problem_builder() {
-    // A not positive definite.
+    // A not positive definite: A(2, 2) < 0 on a diagonal A, so the failing pivot is row 2,
+    // counted from 1 as in every message of the CLI.
     expect_input_error(
         "A.mtx",
         Some("%%MatrixMarket matrix coordinate real general\n4 4 4\n1 1 2\n2 2 -3\n3 3 5\n4 4 4\n"),
-        &["positive definite"],
+        &["positive definite", "row 2 of A (1-based"],
     );
     // A not symmetric (general file).
     expect_input_error(
@@ -632,6 +650,286 @@ fn data_rejected_by_the_problem_builder() {
         "meta.json",
         Some(r#"{"n": 4, "p": 2, "F": [0.5, -1], "alpha_start": 0, "alpha_end": 1}"#),
         &["meta.json", ">= 0"],
+    );
+}
+
+/// A, N and T as `array` and `integer` Matrix Market files (dense, column-major) give the
+/// events of the coordinate files, derived by hand.
+#[test]
+fn array_and_integer_matrix_market_files() {
+    let d = TempDir::new("array");
+    write_hand(&DECOUPLED, d.path());
+    // A = diag(2, 3, 5, 4): symmetric array, lower triangle by columns, integer values.
+    let mut a = String::from("%%MatrixMarket matrix array integer symmetric\n4 4\n");
+    for j in 0..4 {
+        for i in j..4 {
+            let v = if i == j {
+                DECOUPLED.a_diag[i] as i64
+            } else {
+                0
+            };
+            a.push_str(&format!("{v}\n"));
+        }
+    }
+    std::fs::write(d.path().join("A.mtx"), a).unwrap();
+    // N = [e1; e3] as a general 2 x 4 array, column by column.
+    std::fs::write(
+        d.path().join("N.mtx"),
+        "%%MatrixMarket matrix array real general\n2 4\n1\n0\n0\n0\n0\n1\n0\n0\n",
+    )
+    .unwrap();
+    // T = [e2; e4] with integer values and a duplicate summing to 1.
+    std::fs::write(
+        d.path().join("T.mtx"),
+        "%%MatrixMarket matrix coordinate integer general\n2 4 3\n1 2 1\n2 4 3\n2 4 -2\n",
+    )
+    .unwrap();
+    let (v, _) = trace_json(d.path(), &[]);
+    assert_events(
+        &v,
+        &[
+            (0.75, 1, "open", "slip+"),
+            (1.0, 2, "open", "slip-"),
+            (2.25, 1, "slip+", "stick"),
+            (3.0, 2, "slip-", "stick"),
+        ],
+    );
+}
+
+/// gen-rect's numeric options take negative values: a negative friction gets the
+/// generator's own error, a negative gap (an initial overlap) is accepted and traced.
+#[test]
+fn gen_rect_negative_values() {
+    let d = TempDir::new("neg");
+    let out = d.path().join("case");
+    let o = run(&["gen-rect", out.to_str().unwrap(), "--friction", "-1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("friction = -1 must be finite and ≥ 0"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!stderr(&o).contains("--"), "a parser tip: {}", stderr(&o));
+    let o = run(&[
+        "gen-rect",
+        out.to_str().unwrap(),
+        "--nx",
+        "6",
+        "--ny",
+        "3",
+        "--gap",
+        "-0.01",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let case = CaseData::read_dir(&out).unwrap();
+    assert_eq!(case.gap, Some(vec![-0.01; case.p()]));
+    let (v, _) = trace_json(&out, &[]);
+    assert_eq!(v["end"]["reason"], "window");
+}
+
+/// `--max-steps 0` is refused as the C ABI refuses it; the counts in the table are in good
+/// English for one transition point.
+#[test]
+fn max_steps_zero_and_one() {
+    let d = TempDir::new("steps");
+    write_hand(&DECOUPLED, d.path());
+    let dir = d.path().to_str().unwrap();
+    let o = run(&["trace", dir, "--max-steps", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-steps 0"), "{}", stderr(&o));
+    assert!(stdout(&o).is_empty());
+    let o = run(&["trace", dir, "--max-steps", "1"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("1 event at 1 transition point; end:"),
+        "{}",
+        stdout(&o)
+    );
+}
+
+/// A `--json` file that cannot be written fails at once (before the problem is read, so
+/// even with a missing problem directory the JSON path is named), with status 2; a JSON
+/// file is not left behind, or changed, when the run fails before writing it.
+#[test]
+fn bad_json_path_fails_before_tracing() {
+    let d = TempDir::new("jsonbad");
+    let missing = d.path().join("no-such-problem");
+    for bad in [
+        d.path().join("no-such-dir").join("out.json"),
+        d.path().to_path_buf(), // a directory
+    ] {
+        let o = run(&[
+            "trace",
+            missing.to_str().unwrap(),
+            "--json",
+            bad.to_str().unwrap(),
+        ]);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+        assert!(
+            err.contains("cannot write the JSON report to") && err.contains(bad.to_str().unwrap()),
+            "{err}"
+        );
+        assert!(stdout(&o).is_empty());
+    }
+    // A writable path with a broken problem: no JSON file is created ...
+    let json = d.path().join("new.json");
+    let o = run(&[
+        "trace",
+        missing.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("meta.json"), "{}", stderr(&o));
+    assert!(!json.exists(), "a JSON file was left behind");
+    // ... and an existing one keeps its content.
+    std::fs::write(&json, "previous report").unwrap();
+    let o = run(&[
+        "trace",
+        missing.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(std::fs::read_to_string(&json).unwrap(), "previous report");
+    // A longer previous file is replaced entirely by the report.
+    std::fs::write(&json, "x".repeat(1 << 20)).unwrap();
+    let h = TempDir::new("jsonok");
+    write_hand(&DECOUPLED, h.path());
+    let o = run(&[
+        "trace",
+        h.path().to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    check_schema(&v);
+}
+
+/// `--progress` shows the phases and the tracing state on stderr, ending with the number
+/// of transition points of the report; without it (stderr is a pipe here, not a terminal)
+/// stderr stays empty.
+#[test]
+fn progress_on_stderr() {
+    let out = TempDir::new("progress");
+    let json = out.path().join("p.json");
+    let sample = sample_dir();
+    let o = run(&[
+        "trace",
+        sample.to_str().unwrap(),
+        "--progress",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    let v: Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let n_tp = v["n_transitions"].as_u64().unwrap();
+    assert!(n_tp > 1);
+    for phase in [
+        "reading",
+        "set-up: n = 1320, p = 30",
+        "start: fixed-alpha solve",
+    ] {
+        assert!(err.contains(phase), "no {phase:?} in {err}");
+    }
+    let last = err.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("fricont: [")
+            && last.contains("] alpha = 1.500000 (100% of [-0.5, 1.5]), ")
+            && last.ends_with(&format!("{n_tp} transition points; done")),
+        "{err}"
+    );
+    // the table on stdout is untouched
+    assert!(stdout(&o).contains("reason window"));
+    let o = run(&["trace", sample.to_str().unwrap()]);
+    assert!(o.status.success());
+    assert!(
+        stderr(&o).is_empty(),
+        "progress without --progress: {}",
+        stderr(&o)
+    );
+}
+
+/// docs/json-report.md lists every key the JSON writer emits, and no other: the keys of a
+/// real report (the sample, run by the CLI) and of a report holding the keys that only a
+/// failed or a bifurcation stop writes are compared with the doc's table, both ways.
+#[test]
+fn every_key_of_the_json_report_is_documented() {
+    use fricont_exchange::report::{BranchReport, PathReport};
+    fn keys(v: &Value, prefix: &str, out: &mut std::collections::BTreeSet<String>) {
+        match v {
+            Value::Object(m) => {
+                for (k, x) in m {
+                    let key = if prefix.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{prefix}.{k}")
+                    };
+                    out.insert(key.clone());
+                    keys(x, &key, out);
+                }
+            }
+            Value::Array(a) => {
+                for x in a {
+                    if x.is_object() {
+                        keys(x, &format!("{prefix}[]"), out);
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let doc_path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../docs/json-report.md");
+    let doc = std::fs::read_to_string(&doc_path).unwrap();
+    let section = doc
+        .split("\n## Keys\n")
+        .nth(1)
+        .expect("a \"## Keys\" section")
+        .split("\n## ")
+        .next()
+        .unwrap();
+    let documented: std::collections::BTreeSet<String> = section
+        .lines()
+        .filter_map(|l| l.strip_prefix("| `"))
+        .map(|l| l.split('`').next().unwrap().to_string())
+        .collect();
+    assert!(documented.len() > 20, "{documented:?}");
+
+    let mut emitted = std::collections::BTreeSet::new();
+    let (v, _) = trace_json(&sample_dir(), &[]);
+    keys(&v, "", &mut emitted);
+    // The keys only a failure or a bifurcation stop writes, from the writer itself.
+    let case = CaseData::read_dir(&sample_dir()).unwrap();
+    let problem = Arc::new(case.problem(None).unwrap());
+    let mut path = Path::new(
+        problem,
+        case.load().unwrap(),
+        PathOptions::window(case.alpha_start, case.alpha_end),
+    )
+    .unwrap();
+    path.start(case.alpha_start, None).unwrap();
+    path.step().unwrap();
+    let mut r = PathReport::from_path(&mut path, Default::default());
+    r.end.message = Some("a failure".into());
+    r.end.branches = Some(vec![BranchReport {
+        classes: vec![Class::Open; case.p()],
+        direction: 1,
+        orientation_preserving: true,
+    }]);
+    keys(&serde_json::to_value(&r).unwrap(), "", &mut emitted);
+    let undocumented: Vec<&String> = emitted.difference(&documented).collect();
+    let stale: Vec<&String> = documented.difference(&emitted).collect();
+    assert!(
+        undocumented.is_empty(),
+        "keys missing from docs/json-report.md: {undocumented:?}"
+    );
+    assert!(
+        stale.is_empty(),
+        "docs/json-report.md documents keys the writer does not emit: {stale:?}"
     );
 }
 

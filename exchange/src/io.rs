@@ -1,15 +1,22 @@
-//! The exchange format (SPEC §7): a problem directory with `A.mtx`, `N.mtx`, `T.mtx`
-//! (Matrix Market coordinate real, `general` or `symmetric`), `f0.txt`, `f1.txt`,
-//! optional `gap.txt`, and `meta.json`.
+//! The exchange format (`docs/exchange-format.md`): a problem directory with `A.mtx`,
+//! `N.mtx`, `T.mtx` (Matrix Market), `f0.txt`, `f1.txt`, optional `gap.txt`, and
+//! `meta.json`.
 //!
 //! Reading rules (every violation is an [`Error::Io`] whose one-line message names the file
-//! and, where there is one, the 1-based line):
-//! - Matrix Market: the header `%%MatrixMarket matrix coordinate real|integer
+//! and, where there is one, the 1-based line; it quotes at most a short excerpt of the
+//! offending text):
+//! - Matrix Market: the header `%%MatrixMarket matrix coordinate|array real|integer
 //!   general|symmetric` (case-insensitive), then comment lines (`%`) and blank lines, then
-//!   the size line `rows cols entries`, then exactly `entries` lines `i j value` with 1-based
-//!   indices. Repeated entries are summed (assembly convention). A `symmetric` file must be
-//!   square and store one triangle only (the lower one, as the Matrix Market standard says,
-//!   or the upper one); it is expanded to full storage. Values must be finite.
+//!   the size line. `coordinate`: the size line `rows cols entries`, then exactly `entries`
+//!   lines `i j value` with 1-based indices; **repeated entries are summed** (assembly
+//!   convention, the same as the C ABI's CSR input). `array`: the size line `rows cols`,
+//!   then the values one a line, column by column (dense; exact zeros are not stored).
+//!   A `symmetric` file must be square; in coordinate form it stores one triangle only
+//!   (the lower one, as the standard says, or the upper one), in array form the lower
+//!   triangle with the diagonal, column by column; it is expanded to full storage.
+//!   `integer` values are signed decimal integers, `real` ones finite numbers (`1.5D+00`
+//!   too). `pattern`, `complex`, `hermitian` and `skew-symmetric` files are refused with
+//!   a message saying why.
 //! - Vector files: one number a line (blank lines ignored), finite, exactly `n` (`f0`,
 //!   `f1`) or `p` (`gap`) of them.
 //! - Compression: any of these files may instead be given gzip-compressed as `NAME.gz`
@@ -311,7 +318,10 @@ fn parse_meta(path: &FsPath, text: &str) -> Result<Meta> {
             _ => Err(io_err(
                 path,
                 None,
-                format!("\"{key}\" must be a positive integer, found {v}"),
+                format!(
+                    "\"{key}\" must be a positive integer, found {}",
+                    excerpt(&v.to_string())
+                ),
             )),
         }
     };
@@ -321,7 +331,10 @@ fn parse_meta(path: &FsPath, text: &str) -> Result<Meta> {
             _ => Err(io_err(
                 path,
                 None,
-                format!("\"{key}\" must be a finite number, found {v}"),
+                format!(
+                    "\"{key}\" must be a finite number, found {}",
+                    excerpt(&v.to_string())
+                ),
             )),
         }
     };
@@ -368,6 +381,18 @@ fn parse_meta(path: &FsPath, text: &str) -> Result<Meta> {
     })
 }
 
+/// At most a short excerpt of an input text for a message: texts up to 40 characters as
+/// they are, longer ones cut to their first 32 characters with the length in bytes (a
+/// corrupt file may hold a line of megabytes; a message stays one short line).
+fn excerpt(s: &str) -> String {
+    const KEEP: usize = 32;
+    if s.chars().nth(40).is_none() {
+        return s.to_string();
+    }
+    let cut = s.char_indices().nth(KEEP).map_or(s.len(), |(k, _)| k);
+    format!("{}… ({} bytes)", &s[..cut], s.len())
+}
+
 /// Parses a real number as written by C, Fortran (`1.5D+00` too) or Rust; rejects NaN/Inf.
 fn parse_real(path: &FsPath, line: usize, tok: &str, what: &str) -> Result<f64> {
     let parsed = tok.parse::<f64>().ok().or_else(|| {
@@ -387,9 +412,23 @@ fn parse_real(path: &FsPath, line: usize, tok: &str, what: &str) -> Result<f64> 
         None => Err(io_err(
             path,
             Some(line),
-            format!("{what} \"{tok}\" is not a number"),
+            format!("{what} \"{}\" is not a number", excerpt(tok)),
         )),
     }
+}
+
+/// Parses the value of an `integer` Matrix Market file (a signed decimal integer).
+fn parse_integer(path: &FsPath, line: usize, tok: &str) -> Result<f64> {
+    tok.parse::<i64>().map(|v| v as f64).map_err(|_| {
+        io_err(
+            path,
+            Some(line),
+            format!(
+                "value \"{}\" is not an integer (the header declares the field integer)",
+                excerpt(tok)
+            ),
+        )
+    })
 }
 
 fn parse_count(path: &FsPath, line: usize, tok: &str, what: &str) -> Result<usize> {
@@ -397,16 +436,108 @@ fn parse_count(path: &FsPath, line: usize, tok: &str, what: &str) -> Result<usiz
         io_err(
             path,
             Some(line),
-            format!("{what} \"{tok}\" is not a non-negative integer"),
+            format!("{what} \"{}\" is not a non-negative integer", excerpt(tok)),
         )
     })
 }
 
-/// Reads a Matrix Market coordinate file into full-storage CSR. `expect` (rows, cols), if
-/// given, is checked against the size line (`expect_what` explains where it comes from).
+/// Reads a Matrix Market file into full-storage CSR. `expect` (rows, cols), if given, is
+/// checked against the size line (`expect_what` explains where it comes from).
 fn read_mtx(path: &FsPath, expect: Option<(usize, usize)>, expect_what: &str) -> Result<CsrMatrix> {
     let (path, text) = read_text(path)?;
     parse_mtx(&path, &text, expect, expect_what)
+}
+
+/// The header every accepted Matrix Market file has (for messages).
+const MM_HEADER: &str = "%%MatrixMarket matrix coordinate|array real|integer general|symmetric";
+
+/// What a Matrix Market header declares (only the variants fricont reads).
+struct MmHeader {
+    /// `array` (dense, column-major) rather than `coordinate`.
+    array: bool,
+    /// Field `integer` rather than `real`.
+    integer: bool,
+    /// Symmetry `symmetric` rather than `general`.
+    symmetric: bool,
+}
+
+/// Parses the header line; every unsupported variant is a one-line error saying why.
+fn parse_mm_header(path: &FsPath, header: &str) -> Result<MmHeader> {
+    let err = |msg: String| Err(io_err(path, Some(1), msg));
+    let h: Vec<String> = header
+        .split_whitespace()
+        .map(|s| s.to_ascii_lowercase())
+        .collect();
+    if h.first().map(String::as_str) != Some("%%matrixmarket") {
+        return err(format!("bad header: expected \"{MM_HEADER}\""));
+    }
+    if h.len() != 5 {
+        return err(format!(
+            "bad header \"{}\": expected \"{MM_HEADER}\"",
+            excerpt(header.trim())
+        ));
+    }
+    if h[1] != "matrix" {
+        return err(format!(
+            "unsupported object \"{}\" (expected matrix: \"{MM_HEADER}\")",
+            excerpt(&h[1])
+        ));
+    }
+    let array = match h[2].as_str() {
+        "coordinate" => false,
+        "array" => true,
+        other => {
+            return err(format!(
+                "unsupported format \"{}\" (expected coordinate or array)",
+                excerpt(other)
+            ));
+        }
+    };
+    let integer = match h[3].as_str() {
+        "real" => false,
+        "integer" => true,
+        "pattern" => {
+            return err(
+                "field \"pattern\" is not supported: a pattern file stores no values (write the matrix with field real or integer)".into(),
+            );
+        }
+        "complex" => {
+            return err(
+                "field \"complex\" is not supported: A, N and T are real matrices (use field real or integer)".into(),
+            );
+        }
+        other => {
+            return err(format!(
+                "unsupported field \"{}\" (expected real or integer)",
+                excerpt(other)
+            ));
+        }
+    };
+    let symmetric = match h[4].as_str() {
+        "general" => false,
+        "symmetric" => true,
+        "hermitian" => {
+            return err(
+                "symmetry \"hermitian\" is not supported: it needs complex values (use general or symmetric)".into(),
+            );
+        }
+        "skew-symmetric" => {
+            return err(
+                "symmetry \"skew-symmetric\" is not supported: no stiffness or contact matrix is skew-symmetric (use general or symmetric)".into(),
+            );
+        }
+        other => {
+            return err(format!(
+                "unsupported symmetry \"{}\" (expected general or symmetric)",
+                excerpt(other)
+            ));
+        }
+    };
+    Ok(MmHeader {
+        array,
+        integer,
+        symmetric,
+    })
 }
 
 fn parse_mtx(
@@ -424,43 +555,13 @@ fn parse_mtx(
             "empty file (expected a %%MatrixMarket header)",
         ));
     };
-    let h: Vec<String> = header
-        .split_whitespace()
-        .map(|s| s.to_ascii_lowercase())
-        .collect();
-    if h.first().map(String::as_str) != Some("%%matrixmarket") {
-        return Err(io_err(
-            path,
-            Some(1),
-            "bad header: expected \"%%MatrixMarket matrix coordinate real general|symmetric\"",
-        ));
-    }
-    if h.len() != 5 || h[1] != "matrix" || h[2] != "coordinate" {
-        return Err(io_err(
-            path,
-            Some(1),
-            format!(
-                "bad header \"{}\": expected \"%%MatrixMarket matrix coordinate real general|symmetric\"",
-                header.trim()
-            ),
-        ));
-    }
-    if h[3] != "real" && h[3] != "integer" {
-        return Err(io_err(
-            path,
-            Some(1),
-            format!("unsupported field \"{}\" (expected real)", h[3]),
-        ));
-    }
-    let symmetric = match h[4].as_str() {
-        "general" => false,
-        "symmetric" => true,
-        other => {
-            return Err(io_err(
-                path,
-                Some(1),
-                format!("unsupported symmetry \"{other}\" (expected general or symmetric)"),
-            ));
+    let hd = parse_mm_header(path, header)?;
+    let symmetric = hd.symmetric;
+    let value = |ln: usize, tok: &str| {
+        if hd.integer {
+            parse_integer(path, ln, tok)
+        } else {
+            parse_real(path, ln, tok, "value")
         }
     };
     // Size line (after comments and blank lines).
@@ -473,24 +574,31 @@ fn parse_mtx(
         size = Some((ln, t));
         break;
     }
+    let size_form = if hd.array {
+        "rows cols"
+    } else {
+        "rows cols entries"
+    };
     let Some((size_ln, size_line)) = size else {
         return Err(io_err(
             path,
             None,
-            "missing size line \"rows cols entries\" after the header",
+            format!("missing size line \"{size_form}\" after the header"),
         ));
     };
-    let toks: Vec<&str> = size_line.split_whitespace().collect();
-    if toks.len() != 3 {
+    let toks: Vec<&str> = size_line.split_whitespace().take(4).collect();
+    if toks.len() != if hd.array { 2 } else { 3 } {
         return Err(io_err(
             path,
             Some(size_ln),
-            format!("bad size line \"{size_line}\": expected \"rows cols entries\""),
+            format!(
+                "bad size line \"{}\": expected \"{size_form}\"",
+                excerpt(size_line)
+            ),
         ));
     }
     let nrows = parse_count(path, size_ln, toks[0], "row count")?;
     let ncols = parse_count(path, size_ln, toks[1], "column count")?;
-    let nnz = parse_count(path, size_ln, toks[2], "entry count")?;
     if let Some((er, ec)) = expect
         && (er, ec) != (nrows, ncols)
     {
@@ -507,6 +615,16 @@ fn parse_mtx(
             format!("a symmetric matrix must be square, this one is {nrows}x{ncols}"),
         ));
     }
+    let name = path.file_name().map_or_else(
+        || path.display().to_string(),
+        |s| s.to_string_lossy().into_owned(),
+    );
+    if hd.array {
+        let triplets = parse_array_values(path, lines, nrows, ncols, symmetric, size_ln, value)?;
+        return CsrMatrix::from_triplets(&name, nrows, ncols, &triplets)
+            .map_err(|e| io_err(path, None, e));
+    }
+    let nnz = parse_count(path, size_ln, toks[2], "entry count")?;
     // Reserve for the announced entries, but never more than the file can hold (an entry
     // line has at least 6 bytes): a corrupt size line must not trigger a huge allocation.
     let max_entries = nnz.min(text.len() / 6 + 1);
@@ -562,7 +680,7 @@ fn parse_mtx(
                 format!("column index {j} out of range 1..={ncols} (indices are 1-based)"),
             ));
         }
-        let v = parse_real(path, ln, tv, "value")?;
+        let v = value(ln, tv)?;
         triplets.push((i - 1, j - 1, v));
         if symmetric && i != j {
             let lower = i > j;
@@ -603,11 +721,91 @@ fn parse_mtx(
             ),
         ));
     }
-    let name = path.file_name().map_or_else(
-        || path.display().to_string(),
-        |s| s.to_string_lossy().into_owned(),
-    );
     CsrMatrix::from_triplets(&name, nrows, ncols, &triplets).map_err(|e| io_err(path, None, e))
+}
+
+/// The values of an `array` file (dense, column-major, one value a line; for `symmetric`
+/// the lower triangle with the diagonal, column by column, as the Matrix Market standard
+/// says) as 0-based triplets, both triangles for `symmetric`, exact zeros left out.
+fn parse_array_values<'a>(
+    path: &FsPath,
+    lines: impl Iterator<Item = (usize, &'a str)>,
+    nrows: usize,
+    ncols: usize,
+    symmetric: bool,
+    size_ln: usize,
+    value: impl Fn(usize, &str) -> Result<f64>,
+) -> Result<Vec<(usize, usize, f64)>> {
+    let expected = if symmetric {
+        nrows.checked_mul(nrows + 1).map(|m| m / 2)
+    } else {
+        nrows.checked_mul(ncols)
+    }
+    .ok_or_else(|| {
+        io_err(
+            path,
+            Some(size_ln),
+            format!("a {nrows}x{ncols} array is too large"),
+        )
+    })?;
+    let what = if symmetric {
+        format!(
+            "{expected} values (the lower triangle of a {nrows}x{ncols} array, column by column)"
+        )
+    } else {
+        format!("{expected} values (a {nrows}x{ncols} array, column by column)")
+    };
+    let mut triplets: Vec<(usize, usize, f64)> = Vec::new();
+    // Position of the next value: column j, row i.
+    let (mut i, mut j) = (0usize, 0usize);
+    let mut count = 0usize;
+    let mut last_ln = size_ln;
+    for (ln, l) in lines {
+        last_ln = ln;
+        let t = l.trim();
+        if t.is_empty() || t.starts_with('%') {
+            continue;
+        }
+        if count == expected {
+            return Err(io_err(
+                path,
+                Some(ln),
+                format!("more values than the {what} announced on line {size_ln}"),
+            ));
+        }
+        let mut it = t.split_ascii_whitespace();
+        let (Some(tv), None) = (it.next(), it.next()) else {
+            return Err(io_err(
+                path,
+                Some(ln),
+                format!(
+                    "expected one value per line (array format), found {} fields",
+                    t.split_ascii_whitespace().count()
+                ),
+            ));
+        };
+        let v = value(ln, tv)?;
+        if v != 0.0 {
+            triplets.push((i, j, v));
+            if symmetric && i != j {
+                triplets.push((j, i, v));
+            }
+        }
+        count += 1;
+        i += 1;
+        if i == nrows {
+            j += 1;
+            i = if symmetric { j } else { 0 };
+        }
+    }
+    if count < expected {
+        return Err(io_err(
+            path,
+            Some(last_ln),
+            format!("only {count} values, expected {what} as announced on line {size_ln}"),
+        ));
+    }
+    Ok(triplets)
 }
 
 /// Reads `expect` numbers, one a line (blank lines ignored).
@@ -916,21 +1114,286 @@ mod tests {
         assert!(m.contains(":1:") && m.contains("bad header"), "{m}");
         let m = broken(
             "N.mtx",
-            "%%MatrixMarket matrix array real general\n1 3\n0\n1\n0\n",
-        );
-        assert!(m.contains(":1:") && m.contains("bad header"), "{m}");
-        let m = broken(
-            "N.mtx",
             "%%MatrixMarket matrix coordinate complex general\n1 3 1\n1 2 1 0\n",
         );
-        assert!(m.contains("complex"), "{m}");
+        assert!(
+            m.contains(":1:") && m.contains("\"complex\" is not supported"),
+            "{m}"
+        );
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix coordinate pattern general\n1 3 1\n1 2\n",
+        );
+        assert!(
+            m.contains(":1:") && m.contains("\"pattern\" is not supported"),
+            "{m}"
+        );
+        assert!(m.contains("no values"), "{m}");
+        let m = broken(
+            "A.mtx",
+            "%%MatrixMarket matrix coordinate complex hermitian\n3 3 1\n1 1 4 0\n",
+        );
+        assert!(m.contains(":1:") && m.contains("complex"), "{m}");
+        let m = broken(
+            "A.mtx",
+            "%%MatrixMarket matrix array real hermitian\n3 3\n4\n0\n0\n4\n0\n4\n",
+        );
+        assert!(
+            m.contains(":1:") && m.contains("\"hermitian\" is not supported"),
+            "{m}"
+        );
         let m = broken(
             "N.mtx",
             "%%MatrixMarket matrix coordinate real skew-symmetric\n1 3 1\n1 2 1\n",
         );
-        assert!(m.contains("skew-symmetric"), "{m}");
+        assert!(m.contains("\"skew-symmetric\" is not supported"), "{m}");
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket vector coordinate real general\n1 3 1\n1 2 1\n",
+        );
+        assert!(m.contains("object \"vector\""), "{m}");
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix sparse real general\n1 3 1\n1 2 1\n",
+        );
+        assert!(m.contains("format \"sparse\""), "{m}");
         let m = broken("N.mtx", "");
         assert!(m.contains("empty"), "{m}");
+    }
+
+    /// `integer` files (coordinate and array) read as the real ones; a non-integer value
+    /// in an integer file is an error naming the line.
+    #[test]
+    fn integer_fields_are_read() {
+        let t = TempDir::new("int");
+        write_case(&t.0);
+        std::fs::write(
+            t.0.join("A.mtx"),
+            "%%MatrixMarket matrix coordinate integer symmetric\n3 3 5\n1 1 4\n2 1 -1\n2 2 +4\n3 2 -1\n3 3 4\n",
+        )
+        .unwrap();
+        std::fs::write(
+            t.0.join("N.mtx"),
+            "%%MatrixMarket matrix array integer general\n1 3\n0\n1\n0\n",
+        )
+        .unwrap();
+        let c = CaseData::read_dir(&t.0).unwrap();
+        assert_eq!(
+            dense(&c.a),
+            vec![4.0, -1.0, 0.0, -1.0, 4.0, -1.0, 0.0, -1.0, 4.0]
+        );
+        assert_eq!(dense(&c.n_mat), vec![0.0, 1.0, 0.0]);
+        assert_eq!(c.n_mat.nnz(), 1, "exact zeros of an array are not stored");
+        let m = broken(
+            "T.mtx",
+            "%%MatrixMarket matrix coordinate integer general\n1 3 1\n1 3 1.5\n",
+        );
+        assert!(
+            m.contains(":3:") && m.contains("\"1.5\" is not an integer"),
+            "{m}"
+        );
+        let m = broken(
+            "T.mtx",
+            "%%MatrixMarket matrix array integer general\n1 3\n0\n0\n1e0\n",
+        );
+        assert!(
+            m.contains(":5:") && m.contains("\"1e0\" is not an integer"),
+            "{m}"
+        );
+    }
+
+    /// `array` files are dense and column-major (the Matrix Market standard): a 2 × 3
+    /// general array and a 3 × 3 symmetric one (lower triangle, column by column).
+    #[test]
+    fn array_files_are_column_major() {
+        let p = FsPath::new("M.mtx");
+        let m = parse_mtx(
+            p,
+            "%%MatrixMarket matrix array real general\n% a comment\n2 3\n1\n2\n3\n\n4\n5\n6.5\n",
+            None,
+            "",
+        )
+        .unwrap();
+        assert_eq!((m.nrows(), m.ncols()), (2, 3));
+        assert_eq!(dense(&m), vec![1.0, 3.0, 5.0, 2.0, 4.0, 6.5]);
+        // lower triangle by columns: (1,1) (2,1) (3,1) | (2,2) (3,2) | (3,3)
+        let m = parse_mtx(
+            p,
+            "%%MatrixMarket matrix array real symmetric\n3 3\n4\n-1\n0\n5\n-2\n6\n",
+            None,
+            "",
+        )
+        .unwrap();
+        assert_eq!(
+            dense(&m),
+            vec![4.0, -1.0, 0.0, -1.0, 5.0, -2.0, 0.0, -2.0, 6.0]
+        );
+        assert_eq!(m.nnz(), 7);
+        // and through a problem directory, with the sizes checked against meta.json
+        let t = TempDir::new("array");
+        write_case(&t.0);
+        std::fs::write(
+            t.0.join("A.mtx"),
+            "%%MatrixMarket matrix array real symmetric\n3 3\n4\n-1\n0\n4\n-1\n4\n",
+        )
+        .unwrap();
+        std::fs::write(
+            t.0.join("T.mtx"),
+            "%%MatrixMarket matrix array real general\n1 3\n0\n0\n1.0D+00\n",
+        )
+        .unwrap();
+        let c = CaseData::read_dir(&t.0).unwrap();
+        assert_eq!(
+            dense(&c.a),
+            vec![4.0, -1.0, 0.0, -1.0, 4.0, -1.0, 0.0, -1.0, 4.0]
+        );
+        assert_eq!(dense(&c.t_mat), vec![0.0, 0.0, 1.0]);
+    }
+
+    #[test]
+    fn array_file_errors() {
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix array real general\n1 3\n0\n1\n",
+        );
+        assert!(
+            m.contains(":4:") && m.contains("only 2 values, expected 3"),
+            "{m}"
+        );
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix array real general\n1 3\n0\n1\n0\n2\n",
+        );
+        assert!(m.contains(":6:") && m.contains("more values"), "{m}");
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix array real general\n1 3\n0 1\n0\n",
+        );
+        assert!(m.contains(":3:") && m.contains("one value per line"), "{m}");
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix array real general\n1 3 3\n0\n1\n0\n",
+        );
+        assert!(m.contains(":2:") && m.contains("\"rows cols\""), "{m}");
+        let m = broken(
+            "N.mtx",
+            "%%MatrixMarket matrix array real symmetric\n1 3\n0\n1\n0\n",
+        );
+        assert!(m.contains("must be square"), "{m}");
+        let m = broken(
+            "A.mtx",
+            "%%MatrixMarket matrix array real symmetric\n3 3\n4\n-1\n0\n4\nNaN\n4\n",
+        );
+        assert!(m.contains(":7:") && m.contains("NaN"), "{m}");
+        let m = broken("A.mtx", "%%MatrixMarket matrix array real general\n3 3\n");
+        assert!(m.contains("only 0 values, expected 9"), "{m}");
+    }
+
+    /// Repeated entries of a coordinate file are summed (assembly), also in a symmetric
+    /// file's triangle; the symmetry check of a general A sees the sums.
+    #[test]
+    fn coordinate_duplicates_are_summed() {
+        let t = TempDir::new("dup");
+        write_case(&t.0);
+        // A(2,1) = -0.25 - 0.75, A(3,3) = 1 + 3: the hand case's A
+        std::fs::write(
+            t.0.join("A.mtx"),
+            "%%MatrixMarket matrix coordinate real symmetric\n3 3 7\n1 1 4\n2 1 -0.25\n2 2 4\n3 3 1\n3 2 -1\n2 1 -0.75\n3 3 3\n",
+        )
+        .unwrap();
+        let c = CaseData::read_dir(&t.0).unwrap();
+        assert_eq!(
+            dense(&c.a),
+            vec![4.0, -1.0, 0.0, -1.0, 4.0, -1.0, 0.0, -1.0, 4.0]
+        );
+        // general: A(1,2) given as 2 × -0.5, A(2,1) as -1
+        std::fs::write(
+            t.0.join("A.mtx"),
+            "%%MatrixMarket matrix coordinate real general\n3 3 8\n1 1 4\n1 2 -0.5\n1 2 -0.5\n2 1 -1\n2 2 4\n2 3 -1\n3 2 -1\n3 3 4\n",
+        )
+        .unwrap();
+        let c = CaseData::read_dir(&t.0).unwrap();
+        assert_eq!(
+            dense(&c.a),
+            vec![4.0, -1.0, 0.0, -1.0, 4.0, -1.0, 0.0, -1.0, 4.0]
+        );
+        assert!(c.problem(None).is_ok());
+    }
+
+    /// A line of a megabyte, anywhere, gives a one-line message quoting only a short
+    /// excerpt of it (with its length).
+    #[test]
+    fn long_lines_are_not_echoed() {
+        let big = "x".repeat(1 << 20);
+        let digits = "7".repeat(1 << 20);
+        let cases: Vec<(&str, String)> = vec![
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix coordinate {big} general\n1 3 1\n1 2 1\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix {big} real general\n1 3 1\n1 2 1\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix coordinate real general {big}\n1 3 1\n1 2 1\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix coordinate real general\n1 3 {big}\n1 2 1\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix coordinate real general\n1 3 1 {big}\n1 2 1\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix coordinate real general\n1 3 1\n1 {digits} 1\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix coordinate real general\n1 3 1\n1 2 {big}\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix coordinate integer general\n1 3 1\n1 2 {digits}\n"),
+            ),
+            (
+                "N.mtx",
+                format!("%%MatrixMarket matrix array real general\n1 3\n0\n{big}\n0\n"),
+            ),
+            ("f0.txt", format!("0\n{big}\n0\n")),
+            (
+                "meta.json",
+                format!(
+                    "{{\"n\": \"{big}\", \"p\": 1, \"F\": 0.5, \"alpha_start\": 0, \"alpha_end\": 1}}"
+                ),
+            ),
+            (
+                "meta.json",
+                format!(
+                    "{{\"n\": 3, \"p\": 1, \"F\": [\"{big}\"], \"alpha_start\": 0, \"alpha_end\": 1}}"
+                ),
+            ),
+        ];
+        for (file, content) in cases {
+            let m = broken(file, &content);
+            assert!(
+                m.len() < 400,
+                "{file}: a {} byte message: {}…",
+                m.len(),
+                &m[..200]
+            );
+        }
+        // the excerpt says how long the text was
+        let m = broken("f0.txt", &format!("0\n{big}\n0\n"));
+        assert!(m.contains(":2:") && m.contains("(1048576 bytes)"), "{m}");
+        assert_eq!(excerpt("short"), "short");
+        assert_eq!(
+            excerpt(&"é".repeat(50)),
+            format!("{}… (100 bytes)", "é".repeat(32))
+        );
     }
 
     #[test]

@@ -5,8 +5,8 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`io`] | the exchange format of a problem directory (SPEC §7): reading, writing |
-//! | [`report`] | the JSON of a traced path (SPEC §8), the α format, the transition table |
+//! | [`io`] | the exchange format of a problem directory (`docs/exchange-format.md`): reading, writing |
+//! | [`report`] | the JSON report of a traced path (`docs/json-report.md`), the α format, the transition table |
 //! | [`generator`] | the rectangle problems (Q1 plane strain on a rigid foundation) |
 
 pub mod generator;

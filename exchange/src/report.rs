@@ -1,4 +1,5 @@
-//! Reports of a traced path: the JSON object of SPEC §8 and the text table of the CLI.
+//! Reports of a traced path: the JSON report (specified key by key in
+//! `docs/json-report.md`, a test keeps the two in step) and the text table of the CLI.
 //!
 //! Both count nodes, events and transition points from 1, as the founding paper does.
 //! In JSON, α and every other number are written by `serde_json` in shortest round-trip
@@ -77,7 +78,7 @@ fn ser_opt_num<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok, S::
     }
 }
 
-/// The report of a path (SPEC §8), with its fields in the order of the SPEC. Serialise it
+/// The report of a path (`docs/json-report.md`), with its fields in the order of SPEC §8. Serialise it
 /// with `serde_json` (the CLI does); [`path_json`] gives it as a [`Value`].
 ///
 /// Required keys: `n`, `p`, `r`, `alpha_start`, `alpha_end` (the window as asked),
@@ -344,7 +345,7 @@ impl PathReport {
         }
     }
 
-    /// The report as pretty-printed JSON text (keys in the order of SPEC §8), ending with a
+    /// The report as pretty-printed JSON text (keys in the order of the doc), ending with a
     /// newline.
     pub fn to_json_string(&self) -> String {
         // Serialising plain data with string keys cannot fail.
@@ -354,7 +355,7 @@ impl PathReport {
     }
 }
 
-/// The JSON object of SPEC §8 for a path, as a [`Value`] (see [`PathReport`] for the keys;
+/// The JSON report of a path, as a [`Value`] (see [`PathReport`] for the keys;
 /// a `Value` does not keep the key order, [`PathReport::to_json_string`] does).
 pub fn path_json(path: &mut Path, timing: Timing) -> Value {
     serde_json::to_value(PathReport::from_path(path, timing)).unwrap_or(Value::Null)
@@ -478,15 +479,18 @@ pub fn events_csv(rows: &[TransitionRow]) -> String {
     s
 }
 
+/// A count with its noun in the right number: `plural(1, "fold")` is "1 fold",
+/// `plural(0, "fold")` "0 folds" (nouns whose plural adds an `s`).
+pub fn plural(k: usize, noun: &str) -> String {
+    if k == 1 {
+        format!("{k} {noun}")
+    } else {
+        format!("{k} {noun}s")
+    }
+}
+
 /// "1 event at 1 transition point", "3 events at 2 transition points".
 pub fn count_words(events: usize, transitions: usize) -> String {
-    let plural = |k: usize, w: &str| {
-        if k == 1 {
-            format!("{k} {w}")
-        } else {
-            format!("{k} {w}s")
-        }
-    };
     format!(
         "{} at {}",
         plural(events, "event"),
@@ -627,6 +631,8 @@ mod tests {
         assert_eq!(count_words(1, 1), "1 event at 1 transition point");
         assert_eq!(count_words(3, 2), "3 events at 2 transition points");
         assert_eq!(count_words(0, 0), "0 events at 0 transition points");
+        assert_eq!(plural(1, "fold"), "1 fold");
+        assert_eq!(plural(2, "fold"), "2 folds");
     }
 
     #[test]

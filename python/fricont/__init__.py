@@ -281,6 +281,9 @@ class Problem:
     storage : "full" (symmetry checked to 1e-10 relative), "lower" or "upper" (only that
         triangle of A is read).
 
+    Duplicate entries (a COO matrix, or a CSR matrix without canonical format) are summed,
+    as by every fricont interface (C, C++, Fortran, the CLI's Matrix Market files).
+
     Raises ValueError (invalid data: dimensions, NaN/Inf, not symmetric, F < 0, r <= 0)
     and NotPositiveDefinite (A not SPD, with the failing pivot; B rank-deficient).
     """

@@ -12,13 +12,18 @@ use super::status::{fricont_status, fricont_storage};
 use crate::condense::{HostSolve, SolveFailure};
 use crate::problem::{CsrMatrix, Problem, ProblemBuilder, Storage};
 
-/// A sparse matrix in compressed sparse row (CSR) form, as the caller stores it. The
-/// library only reads it during the call that receives it and copies what it needs.
+/// A sparse matrix in compressed sparse row (CSR) form with `int64_t` indices, as the
+/// caller stores it. The library only reads it during the call that receives it and
+/// copies what it needs. For `int32_t` indices (PETSc's default `PetscInt`, Eigen, the
+/// int API of CHOLMOD, scipy) use `fricont_csr_i32` with the `_i32` constructors.
 ///
 /// Row `i` (0-based position) holds the entries `row_ptr[i] - index_base ..
 /// row_ptr[i+1] - index_base` (0-based positions in `col_idx` and `values`); the column
 /// numbers in `col_idx` count from `index_base` too. Within a row the columns may come in
-/// any order but must not repeat (duplicates are rejected, not summed).
+/// any order and may repeat: **duplicate entries are summed** (in the order given), as
+/// scipy, MATLAB's `sparse`, Eigen's `setFromTriplets` and PETSc's `ADD_VALUES` do; the
+/// checks of A (symmetry in full storage, positive definiteness) apply to the summed
+/// matrix.
 #[repr(C)]
 #[derive(Debug, Clone, Copy)]
 #[allow(non_camel_case_types)]
@@ -34,6 +39,34 @@ pub struct fricont_csr {
     pub row_ptr: *const i64,
     /// `nnz` column indices (NULL allowed when `nnz == 0`).
     pub col_idx: *const i64,
+    /// `nnz` values (NULL allowed when `nnz == 0`), finite.
+    pub values: *const f64,
+    /// 0 (C) or 1 (Fortran, MATLAB).
+    pub index_base: i64,
+}
+
+/// A sparse matrix in CSR form with `int32_t` row pointers and column indices: the same
+/// layout and rules as `fricont_csr` (index base, unsorted columns, duplicates summed),
+/// for callers whose matrices hold 32-bit indices, passed to `fricont_problem_new_i32`
+/// and `fricont_problem_new_solve_i32` without a copy on the caller's side (the library
+/// copies during the call, as for `fricont_csr`). The sizes stay `int64_t`; `nnz` and
+/// every row pointer must fit in `int32_t` (they do when the arrays are `int32_t`).
+/// A negative row pointer or column index is `FRICONT_ERR_CSR`, as with 64-bit indices.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+#[allow(non_camel_case_types)]
+pub struct fricont_csr_i32 {
+    /// Number of rows, ≥ 0.
+    pub nrows: i64,
+    /// Number of columns, ≥ 0.
+    pub ncols: i64,
+    /// Number of stored entries: the length of `col_idx` and `values`, and
+    /// `row_ptr[nrows] - index_base`.
+    pub nnz: i64,
+    /// `nrows + 1` row pointers, `row_ptr[0] == index_base`, non-decreasing.
+    pub row_ptr: *const i32,
+    /// `nnz` column indices (NULL allowed when `nnz == 0`).
+    pub col_idx: *const i32,
     /// `nnz` values (NULL allowed when `nnz == 0`), finite.
     pub values: *const f64,
     /// 0 (C) or 1 (Fortran, MATLAB).
@@ -109,32 +142,78 @@ impl ProblemInner {
     }
 }
 
-/// Reads a caller's CSR matrix (`name` for messages).
+/// A caller's CSR struct of either index width (the two C structs differ only there).
+trait CsrIn {
+    /// The index type of `row_ptr` and `col_idx`.
+    type Index: Copy + Into<i64>;
+    /// `(nrows, ncols, nnz, row_ptr, col_idx, values, index_base)`.
+    #[allow(clippy::type_complexity)]
+    fn parts(
+        &self,
+    ) -> (
+        i64,
+        i64,
+        i64,
+        *const Self::Index,
+        *const Self::Index,
+        *const f64,
+        i64,
+    );
+}
+
+impl CsrIn for fricont_csr {
+    type Index = i64;
+    fn parts(&self) -> (i64, i64, i64, *const i64, *const i64, *const f64, i64) {
+        let m = self;
+        (
+            m.nrows,
+            m.ncols,
+            m.nnz,
+            m.row_ptr,
+            m.col_idx,
+            m.values,
+            m.index_base,
+        )
+    }
+}
+
+impl CsrIn for fricont_csr_i32 {
+    type Index = i32;
+    fn parts(&self) -> (i64, i64, i64, *const i32, *const i32, *const f64, i64) {
+        let m = self;
+        (
+            m.nrows,
+            m.ncols,
+            m.nnz,
+            m.row_ptr,
+            m.col_idx,
+            m.values,
+            m.index_base,
+        )
+    }
+}
+
+/// Reads a caller's CSR matrix of either index width (`name` for messages).
 ///
 /// # Safety
-/// `m` is NULL or points to a `fricont_csr` whose arrays are valid for their lengths.
-unsafe fn read_csr(m: *const fricont_csr, name: &str) -> FfiResult<CsrMatrix> {
+/// `m` is NULL or points to a CSR struct whose arrays are valid for their lengths.
+unsafe fn read_csr<M: CsrIn>(m: *const M, name: &str) -> FfiResult<CsrMatrix> {
     // SAFETY: by this function's contract.
     let m = unsafe { handle_ref(m, name) }?;
-    let nrows = len_of(m.nrows, &format!("{name}.nrows"))?;
-    let ncols = len_of(m.ncols, &format!("{name}.ncols"))?;
-    let nnz = len_of(m.nnz, &format!("{name}.nnz"))?;
+    let (nrows, ncols, nnz, rp, ci, vals, base) = m.parts();
+    let nrows = len_of(nrows, &format!("{name}.nrows"))?;
+    let ncols = len_of(ncols, &format!("{name}.ncols"))?;
+    let nnz = len_of(nnz, &format!("{name}.nnz"))?;
     // SAFETY: the struct's arrays have the lengths it states (the caller's contract).
     let (row_ptr, col_idx, values) = unsafe {
         (
-            slice_in(m.row_ptr, nrows + 1, &format!("{name}.row_ptr"))?,
-            slice_in(m.col_idx, nnz, &format!("{name}.col_idx"))?,
-            slice_in(m.values, nnz, &format!("{name}.values"))?,
+            slice_in(rp, nrows + 1, &format!("{name}.row_ptr"))?,
+            slice_in(ci, nnz, &format!("{name}.col_idx"))?,
+            slice_in(vals, nnz, &format!("{name}.values"))?,
         )
     };
     Ok(CsrMatrix::from_raw(
-        name,
-        nrows,
-        ncols,
-        row_ptr,
-        col_idx,
-        values,
-        m.index_base,
+        name, nrows, ncols, row_ptr, col_idx, values, base,
     )?)
 }
 
@@ -182,43 +261,79 @@ pub unsafe extern "C" fn fricont_problem_new(
     t: *const fricont_csr,
     out: *mut *mut fricont_problem,
 ) -> fricont_status {
-    ffi_boundary!({
-        if out.is_null() {
-            return Err(Failure::null(
-                "out (the fricont_problem ** receiving the handle)",
-            ));
-        }
-        // SAFETY: `out` is a valid pointer by contract; clear it before any failure.
-        unsafe { out.write(std::ptr::null_mut()) };
-        // SAFETY: by this function's contract.
-        let (am, nm, tm) = unsafe { (read_csr(a, "A")?, read_csr(n, "N")?, read_csr(t, "T")?) };
-        let storage = storage_of(a_storage)?;
-        let nd = am.nrows();
-        if am.ncols() != nd {
+    // SAFETY: by this function's contract.
+    ffi_boundary!(unsafe { problem_new(a, a_storage, n, t, out) })
+}
+
+/// `fricont_problem_new` for CSR matrices with `int32_t` indices (`fricont_csr_i32`):
+/// the same arguments, checks, defaults, ownership (the arrays are read during the call
+/// and copied) and statuses. A, N and T all use 32-bit indices.
+///
+/// Returns `FRICONT_OK`; `FRICONT_ERR_NULL`; `FRICONT_ERR_LENGTH`; `FRICONT_ERR_RANGE`;
+/// `FRICONT_ERR_CSR` (malformed CSR: a negative or decreasing row pointer, a column index
+/// out of range or negative, index base not 0/1); `FRICONT_ERR_NONFINITE`;
+/// `FRICONT_ERR_PANIC`, as `fricont_problem_new`.
+///
+/// # Safety
+/// As for `fricont_problem_new`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_new_i32(
+    a: *const fricont_csr_i32,
+    a_storage: i32,
+    n: *const fricont_csr_i32,
+    t: *const fricont_csr_i32,
+    out: *mut *mut fricont_problem,
+) -> fricont_status {
+    // SAFETY: by this function's contract.
+    ffi_boundary!(unsafe { problem_new(a, a_storage, n, t, out) })
+}
+
+/// The body of `fricont_problem_new` and `fricont_problem_new_i32`.
+///
+/// # Safety
+/// As for `fricont_problem_new`.
+unsafe fn problem_new<M: CsrIn>(
+    a: *const M,
+    a_storage: i32,
+    n: *const M,
+    t: *const M,
+    out: *mut *mut fricont_problem,
+) -> FfiResult {
+    if out.is_null() {
+        return Err(Failure::null(
+            "out (the fricont_problem ** receiving the handle)",
+        ));
+    }
+    // SAFETY: `out` is a valid pointer by contract; clear it before any failure.
+    unsafe { out.write(std::ptr::null_mut()) };
+    // SAFETY: by this function's contract.
+    let (am, nm, tm) = unsafe { (read_csr(a, "A")?, read_csr(n, "N")?, read_csr(t, "T")?) };
+    let storage = storage_of(a_storage)?;
+    let nd = am.nrows();
+    if am.ncols() != nd {
+        return Err(Failure::length(format!(
+            "A is {}x{}, must be square",
+            nd,
+            am.ncols()
+        )));
+    }
+    let p = nm.nrows();
+    if p == 0 {
+        return Err(Failure::length(
+            "N has 0 rows: there must be at least one contact node",
+        ));
+    }
+    for (name, m) in [("N", &nm), ("T", &tm)] {
+        if m.nrows() != p || m.ncols() != nd {
             return Err(Failure::length(format!(
-                "A is {}x{}, must be square",
-                nd,
-                am.ncols()
+                "{name} is {}x{}, expected p x n = {p}x{nd} (p from the rows of N, n from A)",
+                m.nrows(),
+                m.ncols()
             )));
         }
-        let p = nm.nrows();
-        if p == 0 {
-            return Err(Failure::length(
-                "N has 0 rows: there must be at least one contact node",
-            ));
-        }
-        for (name, m) in [("N", &nm), ("T", &tm)] {
-            if m.nrows() != p || m.ncols() != nd {
-                return Err(Failure::length(format!(
-                    "{name} is {}x{}, expected p x n = {p}x{nd} (p from the rows of N, n from A)",
-                    m.nrows(),
-                    m.ncols()
-                )));
-            }
-        }
-        // SAFETY: `out` is valid (checked above).
-        unsafe { new_handle(out, nd, p, ProblemBuilder::new(am, storage, nm, tm)) }
-    })
+    }
+    // SAFETY: `out` is valid (checked above).
+    unsafe { new_handle(out, nd, p, ProblemBuilder::new(am, storage, nm, tm)) }
 }
 
 /// Writes a new handle for `builder` into `out` (valid, by the callers' contract).
@@ -446,55 +561,98 @@ pub unsafe extern "C" fn fricont_problem_new_solve(
         ptr: user,
         free: free_user,
     };
-    ffi_boundary!({
-        let user = user;
-        if out.is_null() {
-            return Err(Failure::null(
-                "out (the fricont_problem ** receiving the handle)",
-            ));
-        }
-        // SAFETY: `out` is a valid pointer by contract; clear it before any failure.
-        unsafe { out.write(std::ptr::null_mut()) };
-        let Some(f) = solve else {
-            return Err(Failure::null("solve (the host's solve function)"));
-        };
-        let nd = len_of(n, "n")?;
-        if max_block < 1 {
+    // SAFETY: by this function's contract.
+    ffi_boundary!(unsafe { problem_new_solve(n, solve, user, max_block, nmat, tmat, out) })
+}
+
+/// `fricont_problem_new_solve` for N and T with `int32_t` indices (`fricont_csr_i32`):
+/// the same arguments, solve contract, finalizer rule (`free_user` is called exactly once,
+/// at once if this function fails), ownership and statuses.
+///
+/// Returns `FRICONT_OK`; `FRICONT_ERR_NULL`; `FRICONT_ERR_LENGTH`; `FRICONT_ERR_CSR`;
+/// `FRICONT_ERR_NONFINITE`; `FRICONT_ERR_PANIC`, as `fricont_problem_new_solve`.
+///
+/// # Safety
+/// As for `fricont_problem_new_solve`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_new_solve_i32(
+    n: i64,
+    solve: fricont_solve_fn,
+    user: *mut c_void,
+    free_user: fricont_free_fn,
+    max_block: i64,
+    nmat: *const fricont_csr_i32,
+    tmat: *const fricont_csr_i32,
+    out: *mut *mut fricont_problem,
+) -> fricont_status {
+    // Owned here so that the finalizer runs even if the call fails.
+    let user = UserData {
+        ptr: user,
+        free: free_user,
+    };
+    // SAFETY: by this function's contract.
+    ffi_boundary!(unsafe { problem_new_solve(n, solve, user, max_block, nmat, tmat, out) })
+}
+
+/// The body of `fricont_problem_new_solve` and `fricont_problem_new_solve_i32`.
+///
+/// # Safety
+/// As for `fricont_problem_new_solve`.
+unsafe fn problem_new_solve<M: CsrIn>(
+    n: i64,
+    solve: fricont_solve_fn,
+    user: UserData,
+    max_block: i64,
+    nmat: *const M,
+    tmat: *const M,
+    out: *mut *mut fricont_problem,
+) -> FfiResult {
+    if out.is_null() {
+        return Err(Failure::null(
+            "out (the fricont_problem ** receiving the handle)",
+        ));
+    }
+    // SAFETY: `out` is a valid pointer by contract; clear it before any failure.
+    unsafe { out.write(std::ptr::null_mut()) };
+    let Some(f) = solve else {
+        return Err(Failure::null("solve (the host's solve function)"));
+    };
+    let nd = len_of(n, "n")?;
+    if max_block < 1 {
+        return Err(Failure::length(format!(
+            "max_block = {max_block}, must be ≥ 1"
+        )));
+    }
+    // SAFETY: by this function's contract.
+    let (nm, tm) = unsafe { (read_csr(nmat, "N")?, read_csr(tmat, "T")?) };
+    let p = nm.nrows();
+    if p == 0 {
+        return Err(Failure::length(
+            "N has 0 rows: there must be at least one contact node",
+        ));
+    }
+    for (name, m) in [("N", &nm), ("T", &tm)] {
+        if m.nrows() != p || m.ncols() != nd {
             return Err(Failure::length(format!(
-                "max_block = {max_block}, must be ≥ 1"
+                "{name} is {}x{}, expected p x n = {p}x{nd} (p from the rows of N, n as given)",
+                m.nrows(),
+                m.ncols()
             )));
         }
-        // SAFETY: by this function's contract.
-        let (nm, tm) = unsafe { (read_csr(nmat, "N")?, read_csr(tmat, "T")?) };
-        let p = nm.nrows();
-        if p == 0 {
-            return Err(Failure::length(
-                "N has 0 rows: there must be at least one contact node",
-            ));
-        }
-        for (name, m) in [("N", &nm), ("T", &tm)] {
-            if m.nrows() != p || m.ncols() != nd {
-                return Err(Failure::length(format!(
-                    "{name} is {}x{}, expected p x n = {p}x{nd} (p from the rows of N, n as given)",
-                    m.nrows(),
-                    m.ncols()
-                )));
-            }
-        }
-        if 2 * p > nd {
-            return Err(Failure::length(format!(
-                "2p = {} exceeds n = {nd}, so B = [N; T] cannot have full row rank",
-                2 * p
-            )));
-        }
-        let cs = CSolve { f, user };
-        let host = HostSolve::new(
-            Box::new(move |x| cs.call(x)),
-            usize::try_from(max_block).unwrap_or(usize::MAX),
-        );
-        // SAFETY: `out` is valid (checked above).
-        unsafe { new_handle(out, nd, p, ProblemBuilder::with_solve(nd, host, nm, tm)) }
-    })
+    }
+    if 2 * p > nd {
+        return Err(Failure::length(format!(
+            "2p = {} exceeds n = {nd}, so B = [N; T] cannot have full row rank",
+            2 * p
+        )));
+    }
+    let cs = CSolve { f, user };
+    let host = HostSolve::new(
+        Box::new(move |x| cs.call(x)),
+        usize::try_from(max_block).unwrap_or(usize::MAX),
+    );
+    // SAFETY: `out` is valid (checked above).
+    unsafe { new_handle(out, nd, p, ProblemBuilder::with_solve(nd, host, nm, tm)) }
 }
 
 /// Frees a problem handle. NULL is a no-op. Paths created from it stay valid (they hold

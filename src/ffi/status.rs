@@ -66,10 +66,12 @@ pub enum fricont_status {
     /// `fricont_problem_new_condensed`): pass NULL for u there.
     FRICONT_ERR_UNAVAILABLE = -105,
     /// Data: a malformed CSR matrix (index base not 0 or 1, row pointer not starting at
-    /// the base or decreasing or not ending at the base + nnz, column out of range,
-    /// duplicate entry in a row, an entry of A in the wrong triangle for the storage).
+    /// the base or decreasing or not ending at the base + nnz, a column index out of
+    /// range or negative, an entry of A in the wrong triangle for the storage; duplicate
+    /// entries are not an error: they are summed).
     FRICONT_ERR_CSR = -201,
-    /// Data: a NaN or infinite value in A, N, T, the gap, a guess or a load vector.
+    /// Data: a NaN or infinite value in A, N, T (also duplicates whose sum overflows), the
+    /// gap, a guess or a load vector.
     FRICONT_ERR_NONFINITE = -202,
     /// Data: A given in full storage, or a condensed W, is not symmetric (relative
     /// tolerance 1e-10), or the W formed with a host's solve is not (1e-8).
