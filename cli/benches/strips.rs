@@ -65,7 +65,14 @@ fn trace(case: &CaseData, fresh: bool) -> (usize, String, f64, f64, f64, usize) 
     };
     let secs = t.elapsed().as_secs_f64();
     let transitions = path.events().last().map_or(0, |e| e.transition + 1);
-    (transitions, end, setup, start, secs, path.refactorisations())
+    (
+        transitions,
+        end,
+        setup,
+        start,
+        secs,
+        path.refactorisations(),
+    )
 }
 
 fn main() {
