@@ -10,9 +10,10 @@
  *
  * Loads and monitors given as MATLAB function handles. A MATLAB function must not run
  * inside a library call: an error in it would unwind (longjmp or C++ exception) through
- * the library's Rust frames (mexCallMATLABWithTrap traps errors, but not Octave's
- * interrupt, Ctrl-C). So a path with such a load or monitor runs its library calls on
- * a worker thread, and the callback (on that thread) hands the request back to MATLAB:
+ * the library's Rust frames (mexCallMATLABWithTrap traps errors; this way nothing of
+ * MATLAB's, an interrupt included, runs under library frames). So a path with such a
+ * load or monitor runs its library calls on a worker thread, and the callback (on that
+ * thread) hands the request back to MATLAB:
  *
  *   [what, value] = fricont_mex('path_call', id, job, ...)  % 'start', 'run', 'step',
  *                                                           % 'solutions_at'
