@@ -8,22 +8,30 @@
  * against a registry (an unknown or freed id is an error, never a crash); the MEX file
  * is locked (mexLock) while any handle is alive and frees everything at exit.
  *
- * Loads given as MATLAB function handles. A MATLAB function must not run inside a
- * library call: an error in it would unwind (longjmp or C++ exception) through the
- * library's Rust frames. So a path with such a load runs its library calls on a worker
- * thread, and the load callback (on that thread) hands the request back to MATLAB:
+ * Loads and monitors given as MATLAB function handles. A MATLAB function must not run
+ * inside a library call: an error in it would unwind (longjmp or C++ exception) through
+ * the library's Rust frames (mexCallMATLABWithTrap traps errors; this way nothing of
+ * MATLAB's, an interrupt included, runs under library frames). So a path with such a
+ * load or monitor runs its library calls on a worker thread, and the callback (on that
+ * thread) hands the request back to MATLAB:
  *
  *   [what, value] = fricont_mex('path_call', id, job, ...)  % 'start', 'run', 'step',
  *                                                           % 'solutions_at'
- *   while what is 'f' or 'df':   % the library waits for f(value) or f'(value)
- *       [what, value] = fricont_mex('resume', id, fun(value))   % or ('resume', id, [])
- *   end                                                       % to refuse (error)
+ *   while what is not 'done':   % the library waits for f(value) or f'(value) ('f',
+ *                               % 'df') or for the monitor ('monitor', value = [alpha,
+ *                               % transitions, first_event, last_event], from 1)
+ *       [what, value] = fricont_mex('resume', id, reply)  % f(value), or true/false
+ *   end                                                   % (stop?), or [] to refuse
  *   % what is 'done', value the fricont_status of the job
  *
  * The MATLAB function is thus evaluated by MATLAB between MEX calls, on MATLAB's own
  * thread; the library sees only a callback that returns 0 or a nonzero code. The worker
- * never calls the MEX or mx API. A path with an affine load has no worker: 'path_call'
- * returns 'done' at once.
+ * never calls the MEX or mx API. A path with an affine load has no worker until it is
+ * run with a monitor ('path_call', id, 'run', 1); without one 'path_call' returns
+ * 'done' at once. While MATLAB holds a request (its function runs), the path is busy:
+ * any other command on it but 'free' is an error (a load function or monitor calling
+ * into its own path), until the request is answered or 'settle' abandons it (the .m
+ * driver calls 'settle' on its way out, also after an error or Ctrl-C).
  *
  * Index conventions: MATLAB's sparse matrices are CSC with 0-based mwIndex arrays; the
  * CSC arrays of a matrix M are the CSR arrays of M.', so A (symmetric) is passed as
@@ -63,8 +71,9 @@ static void raise_error(const char *id, const char *fmt, ...) {
 
 /* ---- Worker thread (paths with a MATLAB-function load) ---------------------------- */
 
-enum { W_IDLE, W_JOB, W_RUNNING, W_WAIT_LOAD, W_LOAD_READY, W_DONE, W_QUIT };
+enum { W_IDLE, W_JOB, W_RUNNING, W_WAIT_REPLY, W_REPLY_READY, W_DONE, W_QUIT };
 enum { JOB_START, JOB_RUN, JOB_STEP, JOB_SOLUTIONS_AT };
+enum { REQ_F, REQ_DF, REQ_MONITOR };
 
 typedef struct worker {
     pthread_t thread;
@@ -72,6 +81,7 @@ typedef struct worker {
     pthread_cond_t cv;
     int state;
     int abort_calls; /* set when MATLAB abandons a job: callbacks refuse at once */
+    int driving;     /* MATLAB's thread only: a request of the job is in MATLAB's hands */
     fricont_path *path;
     /* the job */
     int job;
@@ -80,29 +90,36 @@ typedef struct worker {
     int64_t job_guess_len;
     int32_t job_status;
     int64_t job_count;
-    /* the pending load request */
-    int req_derivative;
+    /* the pending request: f or f' at req_alpha into req_out, or the monitor */
+    int req_kind;
     double req_alpha;
     double *req_out;
     int64_t req_n;
+    int64_t req_transitions, req_first, req_end;
     int32_t reply_code;
 } worker;
 
-static int32_t worker_callback(worker *w, int derivative, double alpha, double *out, int64_t n) {
+/* Hands a request to MATLAB's thread and waits for the reply: 0, or nonzero to refuse
+ * (load) or stop (monitor); 2 when MATLAB abandoned the job. */
+static int32_t worker_callback(worker *w, int kind, double alpha, double *out, int64_t n,
+                               int64_t transitions, int64_t first, int64_t end) {
     int32_t code;
     pthread_mutex_lock(&w->mu);
     if (w->abort_calls) {
         pthread_mutex_unlock(&w->mu);
         return 2;
     }
-    w->req_derivative = derivative;
+    w->req_kind = kind;
     w->req_alpha = alpha;
     w->req_out = out;
     w->req_n = n;
-    w->state = W_WAIT_LOAD;
+    w->req_transitions = transitions;
+    w->req_first = first;
+    w->req_end = end;
+    w->state = W_WAIT_REPLY;
     pthread_cond_broadcast(&w->cv);
-    while (w->state == W_WAIT_LOAD && !w->abort_calls) pthread_cond_wait(&w->cv, &w->mu);
-    code = w->abort_calls && w->state == W_WAIT_LOAD ? 2 : w->reply_code;
+    while (w->state == W_WAIT_REPLY && !w->abort_calls) pthread_cond_wait(&w->cv, &w->mu);
+    code = w->abort_calls && w->state == W_WAIT_REPLY ? 2 : w->reply_code;
     w->state = W_RUNNING;
     w->req_out = NULL;
     pthread_mutex_unlock(&w->mu);
@@ -110,11 +127,16 @@ static int32_t worker_callback(worker *w, int derivative, double alpha, double *
 }
 
 static int32_t load_cb(double alpha, double *out, int64_t n, void *ud) {
-    return worker_callback((worker *)ud, 0, alpha, out, n);
+    return worker_callback((worker *)ud, REQ_F, alpha, out, n, 0, 0, 0);
 }
 
 static int32_t dload_cb(double alpha, double *out, int64_t n, void *ud) {
-    return worker_callback((worker *)ud, 1, alpha, out, n);
+    return worker_callback((worker *)ud, REQ_DF, alpha, out, n, 0, 0, 0);
+}
+
+static int32_t monitor_cb(double alpha, int64_t transitions, int64_t first, int64_t end,
+                          void *ud) {
+    return worker_callback((worker *)ud, REQ_MONITOR, alpha, NULL, 0, transitions, first, end);
 }
 
 static void *worker_main(void *arg) {
@@ -149,7 +171,7 @@ static void *worker_main(void *arg) {
 static int worker_wait(worker *w) {
     int s;
     pthread_mutex_lock(&w->mu);
-    while (w->state != W_DONE && w->state != W_WAIT_LOAD) pthread_cond_wait(&w->cv, &w->mu);
+    while (w->state != W_DONE && w->state != W_WAIT_REPLY) pthread_cond_wait(&w->cv, &w->mu);
     s = w->state;
     pthread_mutex_unlock(&w->mu);
     return s;
@@ -159,15 +181,33 @@ static int worker_wait(worker *w) {
  * callback refuses, the library call returns FRICONT_ERR_CALLBACK, the path ends. */
 static void worker_settle(worker *w) {
     pthread_mutex_lock(&w->mu);
-    if (w->state == W_JOB || w->state == W_RUNNING || w->state == W_WAIT_LOAD ||
-        w->state == W_LOAD_READY) {
+    if (w->state == W_JOB || w->state == W_RUNNING || w->state == W_WAIT_REPLY ||
+        w->state == W_REPLY_READY) {
         w->abort_calls = 1;
         pthread_cond_broadcast(&w->cv);
         while (w->state != W_DONE) pthread_cond_wait(&w->cv, &w->mu);
     }
     w->abort_calls = 0;
+    w->driving = 0;
     w->state = W_IDLE;
     pthread_mutex_unlock(&w->mu);
+}
+
+/* A worker for `path`, its thread started; NULL if that fails. */
+static worker *worker_new(fricont_path *path) {
+    worker *w = (worker *)calloc(1, sizeof *w);
+    if (!w) return NULL;
+    pthread_mutex_init(&w->mu, NULL);
+    pthread_cond_init(&w->cv, NULL);
+    w->state = W_IDLE;
+    w->path = path;
+    if (pthread_create(&w->thread, NULL, worker_main, w) != 0) {
+        pthread_cond_destroy(&w->cv);
+        pthread_mutex_destroy(&w->mu);
+        free(w);
+        return NULL;
+    }
+    return w;
 }
 
 static void worker_stop(worker *w) {
@@ -423,9 +463,9 @@ static void set_state_fields(mxArray *s, mwIndex k, const state_buf *b, int64_t 
 static const char *state_fields[] = {"alpha", "residual", "u", "lambda_n", "lambda_t", "classes"};
 
 static const char *end_reason_name(int32_t r) {
-    static const char *names[] = {"none", "window", "max_steps", "closed_loop",
-                                  "bifurcation", "failed"};
-    return r >= 0 && r <= 5 ? names[r] : "unknown";
+    static const char *names[] = {"none",        "window", "max_steps", "closed_loop",
+                                  "bifurcation", "failed", "stopped"};
+    return r >= 0 && r <= 6 ? names[r] : "unknown";
 }
 
 /* ---- Commands -------------------------------------------------------------------- */
@@ -448,11 +488,20 @@ static int32_t run_job_direct(entry *e, int job, double alpha, const double *gue
     }
 }
 
-/* Returns [what, value] after a job finished or a load was requested. */
+/* Returns [what, value] after a job finished or a load or the monitor was requested. */
 static void job_outputs(int nlhs, mxArray *plhs[], entry *e, int32_t status, int64_t count,
                         int waiting) {
-    if (waiting) {
-        plhs[0] = mxCreateString(e->w->req_derivative ? "df" : "f");
+    if (waiting && e->w->req_kind == REQ_MONITOR) {
+        worker *w = e->w;
+        plhs[0] = mxCreateString("monitor");
+        plhs[1] = mxCreateDoubleMatrix(1, 4, mxREAL);
+        double *v = mxGetPr(plhs[1]);
+        v[0] = w->req_alpha;
+        v[1] = (double)w->req_transitions;
+        v[2] = (double)(w->req_first + 1); /* the new events, from 1, last included */
+        v[3] = (double)w->req_end;
+    } else if (waiting) {
+        plhs[0] = mxCreateString(e->w->req_kind == REQ_DF ? "df" : "f");
         plhs[1] = mxCreateDoubleScalar(e->w->req_alpha);
     } else {
         plhs[0] = mxCreateString("done");
@@ -472,22 +521,37 @@ static void finish_job(int nlhs, mxArray *plhs[], entry *e) {
         count = e->w->job_count;
         e->w->state = W_IDLE;
         pthread_mutex_unlock(&e->w->mu);
+        e->w->driving = 0;
         job_outputs(nlhs, plhs, e, st, count, 0);
     } else {
+        e->w->driving = 1;
         job_outputs(nlhs, plhs, e, 0, 0, 1);
     }
+}
+
+/* The path of prhs[1], with no job running: a job MATLAB abandoned earlier (an error or
+ * Ctrl-C in the .m code, without 'settle') ends now. A request still in MATLAB's hands
+ * means that its load function or monitor calls into its own path: an error. */
+static entry *idle_path(const mxArray *id) {
+    entry *e = lookup(id, KIND_PATH);
+    if (e->w && e->w->driving)
+        mexErrMsgIdAndTxt("fricont:order", "fricont: the path is in use: its own load "
+                                           "function or monitor called into it");
+    if (e->w) worker_settle(e->w);
+    return e;
 }
 
 static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[],
                           const char *cmd) {
     NEED(3);
-    entry *e = lookup(prhs[1], KIND_PATH);
+    entry *e = idle_path(prhs[1]);
     char job_name[32];
     get_string(prhs[2], job_name, sizeof job_name, "job");
     int job;
     double alpha = 0;
     const double *guess = NULL;
     int64_t guess_len = 0;
+    int monitored = 0;
     if (strcmp(job_name, "start") == 0) {
         NEED(4);
         job = JOB_START;
@@ -497,7 +561,10 @@ static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *pr
             guess_len = (int64_t)mxGetNumberOfElements(prhs[4]);
         }
     } else if (strcmp(job_name, "run") == 0) {
+        /* ('path_call', id, 'run', monitored): with monitored nonzero the library calls
+         * the monitor after each transition point, and MATLAB answers it. */
         job = JOB_RUN;
+        monitored = nrhs > 3 && get_scalar(prhs[3], "monitored") != 0;
     } else if (strcmp(job_name, "step") == 0) {
         job = JOB_STEP;
     } else if (strcmp(job_name, "solutions_at") == 0) {
@@ -509,6 +576,13 @@ static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *pr
                           job_name);
         return;
     }
+    if (monitored && !e->w) { /* an affine path: its first monitored run */
+        e->w = worker_new(e->path);
+        if (!e->w) mexErrMsgIdAndTxt("fricont:thread", "fricont: cannot start a worker thread");
+    }
+    if (job == JOB_RUN && e->w)
+        check(fricont_path_set_monitor(e->path, monitored ? monitor_cb : NULL, e->w, NULL),
+              "monitor");
     if (!e->w) {
         int64_t count = 0;
         int32_t st = run_job_direct(e, job, alpha, guess, guess_len, &count);
@@ -516,7 +590,6 @@ static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *pr
         return;
     }
     worker *w = e->w;
-    worker_settle(w); /* a job MATLAB abandoned earlier ends now */
     pthread_mutex_lock(&w->mu);
     free(w->job_guess);
     w->job_guess = NULL;
@@ -542,23 +615,30 @@ static void cmd_resume(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[
     NEED(3);
     entry *e = lookup(prhs[1], KIND_PATH);
     worker *w = e->w;
-    if (!w) mexErrMsgIdAndTxt("fricont:order", "fricont: resume on a path without load function");
+    if (!w) mexErrMsgIdAndTxt("fricont:order", "fricont: resume on a path without worker");
     pthread_mutex_lock(&w->mu);
-    int waiting = w->state == W_WAIT_LOAD;
+    int waiting = w->state == W_WAIT_REPLY;
     pthread_mutex_unlock(&w->mu);
-    if (!waiting) mexErrMsgIdAndTxt("fricont:order", "fricont: no load request is pending");
+    if (!waiting) mexErrMsgIdAndTxt("fricont:order", "fricont: no request is pending");
     const mxArray *v = prhs[2];
     int32_t code = 0;
     if (mxIsEmpty(v)) {
-        code = 1; /* MATLAB refused: its function raised an error */
+        code = 1; /* MATLAB refused: its function raised an error (a monitor: stop) */
+    } else if (w->req_kind == REQ_MONITOR) {
+        /* stop?: the .m code checks that it is a logical or 0/1 scalar */
+        code = (mxIsLogical(v) || mxIsNumeric(v)) && mxGetNumberOfElements(v) == 1 &&
+                       mxGetScalar(v) == 0
+                   ? 0
+                   : 1;
     } else if (!mxIsDouble(v) || mxIsComplex(v) || mxIsSparse(v) ||
                (int64_t)mxGetNumberOfElements(v) != w->req_n) {
         code = 3; /* wrong type or length: the .m code checks first, this is a guard */
     }
     pthread_mutex_lock(&w->mu);
-    if (code == 0) memcpy(w->req_out, mxGetPr(v), sizeof(double) * (size_t)w->req_n);
+    if (code == 0 && w->req_kind != REQ_MONITOR)
+        memcpy(w->req_out, mxGetPr(v), sizeof(double) * (size_t)w->req_n);
     w->reply_code = code;
-    w->state = W_LOAD_READY;
+    w->state = W_REPLY_READY;
     pthread_cond_broadcast(&w->cv);
     pthread_mutex_unlock(&w->mu);
     finish_job(nlhs, plhs, e);
@@ -632,22 +712,15 @@ static void cmd_path_new(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prh
         check(fricont_path_new_affine(pe->problem, f0, f1, pe->n, &path), "path");
     } else {
         int with_derivative = get_scalar(prhs[2], "has_derivative") != 0;
-        w = (worker *)calloc(1, sizeof *w);
-        if (!w) mexErrMsgIdAndTxt("fricont:memory", "fricont: out of memory");
-        pthread_mutex_init(&w->mu, NULL);
-        pthread_cond_init(&w->cv, NULL);
-        w->state = W_IDLE;
+        w = worker_new(NULL);
+        if (!w) mexErrMsgIdAndTxt("fricont:thread", "fricont: cannot start a worker thread");
         int32_t st = fricont_path_new_general(pe->problem, pe->n, load_cb,
                                               with_derivative ? dload_cb : NULL, w, NULL, &path);
-        if (st < 0 || pthread_create(&w->thread, NULL, worker_main, w) != 0) {
-            pthread_cond_destroy(&w->cv);
-            pthread_mutex_destroy(&w->mu);
-            free(w);
-            fricont_path_free(path);
-            if (st < 0) raise_status(st, "path");
-            mexErrMsgIdAndTxt("fricont:thread", "fricont: cannot start a worker thread");
+        if (st < 0) {
+            worker_stop(w);
+            raise_status(st, "path");
         }
-        w->path = path;
+        w->path = path; /* read by the worker's thread only for a job, after the mutex */
     }
     entry *e = add_entry(KIND_PATH);
     e->path = path;
@@ -659,8 +732,7 @@ static void cmd_path_new(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prh
 
 static void cmd_path_set(int nrhs, const mxArray *prhs[], const char *cmd) {
     NEED(4);
-    entry *e = lookup(prhs[1], KIND_PATH);
-    if (e->w) worker_settle(e->w);
+    entry *e = idle_path(prhs[1]);
     char what[16];
     get_string(prhs[2], what, sizeof what, "setting");
     if (strcmp(what, "window") == 0) {
@@ -671,6 +743,9 @@ static void cmd_path_set(int nrhs, const mxArray *prhs[], const char *cmd) {
               "max_steps");
     } else if (strcmp(what, "zero_tol") == 0) {
         check(fricont_path_set_zero_tol(e->path, get_scalar(prhs[3], "zero_tol")), "zero_tol");
+    } else if (strcmp(what, "max_alpha_step") == 0) {
+        check(fricont_path_set_max_alpha_step(e->path, get_scalar(prhs[3], "max_alpha_step")),
+              "max_alpha_step");
     } else {
         mexErrMsgIdAndTxt("fricont:argument", "fricont: unknown path setting '%s'", what);
     }
@@ -679,8 +754,7 @@ static void cmd_path_set(int nrhs, const mxArray *prhs[], const char *cmd) {
 /* The traced path as a struct: events (with states), pieces, start, end. */
 static void cmd_path_result(mxArray *plhs[], int nrhs, const mxArray *prhs[], const char *cmd) {
     NEED(2);
-    entry *e = lookup(prhs[1], KIND_PATH);
-    if (e->w) worker_settle(e->w);
+    entry *e = idle_path(prhs[1]);
     fricont_path *path = e->path;
     int64_t n = e->n, p = e->p, count = 0, pieces = 0;
     check(fricont_path_event_count(path, &count), "events");
@@ -750,8 +824,7 @@ static void cmd_path_result(mxArray *plhs[], int nrhs, const mxArray *prhs[], co
 /* Solutions 1..count of the last solutions_at as a struct array. */
 static void cmd_solutions(mxArray *plhs[], int nrhs, const mxArray *prhs[], const char *cmd) {
     NEED(3);
-    entry *e = lookup(prhs[1], KIND_PATH);
-    if (e->w) worker_settle(e->w);
+    entry *e = idle_path(prhs[1]);
     int64_t count = (int64_t)get_scalar(prhs[2], "count");
     static const char *fields[] = {"alpha", "residual", "u", "lambda_n", "lambda_t",
                                    "classes", "piece", "continuum"};
@@ -772,7 +845,7 @@ static void cmd_solutions(mxArray *plhs[], int nrhs, const mxArray *prhs[], cons
 static void cmd_error_message(mxArray *plhs[], int nrhs, const mxArray *prhs[],
                               const char *cmd) {
     NEED(2);
-    entry *e = lookup(prhs[1], KIND_PATH);
+    entry *e = idle_path(prhs[1]);
     char msg[1024];
     size_t len = fricont_path_error_message(e->path, msg, sizeof msg);
     if (!len) msg[0] = 0;
@@ -822,6 +895,13 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[]) {
     } else if (strcmp(cmd, "status_str") == 0) {
         NEED(2);
         plhs[0] = mxCreateString(fricont_status_str((int32_t)get_scalar(prhs[1], "status")));
+    } else if (strcmp(cmd, "settle") == 0) {
+        /* the .m driver on its way out: a request it left unanswered is refused, the job
+         * ends (a monitor's: stopped). An unknown id is a no-op, as for 'free'. */
+        NEED(2);
+        uint64_t id = get_id(prhs[1]);
+        for (entry *e = registry; e; e = e->next)
+            if (e->id == id && e->w) worker_settle(e->w);
     } else if (strcmp(cmd, "free") == 0) {
         NEED(2);
         remove_entry(get_id(prhs[1])); /* an unknown id is a no-op, as free(NULL) */

@@ -21,7 +21,22 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %          gap (p-vector, default 0), r (augmentation parameter, default 2p/trace(W)),
 %          storage ('full' default, 'lower' or 'upper': which triangle of A is stored),
 %          max_steps (default 10000), zero_tol (default 1e-11),
-%          guess (2p-vector [lambda_n; lambda_t] for the start solve).
+%          guess (2p-vector [lambda_n; lambda_t] for the start solve),
+%          max_alpha_step (alpha units, finite and > 0; default 1/8 of the window): the
+%            largest step of a load function's step control. A feature of the load
+%            narrower than the steps (a bump, a fast oscillation) can be stepped over
+%            unseen; steps no longer than the narrowest feature cannot miss it. No
+%            effect on an affine load, whose pieces are followed exactly.
+%          monitor (function handle): stop = monitor(alpha, transitions, first_event,
+%            last_event), called after each transition point with its alpha, the
+%            number of transition points so far and the new events
+%            res.events(first_event:last_event). It returns true to stop the path
+%            (end_reason 'stopped'; FRICONT_RESUME continues it) or false to go on (1
+%            and 0 are accepted too, any other value is an error); a function without
+%            output arguments never stops it. An error raised in it stops the path
+%            and is rethrown by fricont_trace as it is. Like a load function it runs
+%            between library calls, in MATLAB, and must not call into this path
+%            (fricont_resume or fricont_solutions_at on its result): that is an error.
 %          Any other field is an error (a misspelt option is never ignored).
 %
 %   res    struct (name it anything but "path", MATLAB's search-path function):
@@ -33,11 +48,12 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %     pieces  struct array: alpha_from, alpha_to, direction, orientation, det_sign,
 %             classes.
 %     start   the start point (alpha, residual, u, lambda_n, lambda_t, classes).
-%     end_reason  'window', 'max_steps', 'closed_loop', 'bifurcation' or 'failed'.
+%     end_reason  'window', 'max_steps', 'closed_loop', 'bifurcation', 'failed' or
+%             'stopped' (by the monitor).
 %     n, p, r, window, and handle/load (used by fricont_solutions_at; the library path
 %     is freed when the last copy of the struct is cleared).
 %
-%   See also FRICONT_SOLUTIONS_AT.
+%   See also FRICONT_SOLUTIONS_AT, FRICONT_RESUME.
   if nargin < 7
     error('fricont:argument', 'fricont_trace: needs A, N, T, f0, f1, F and the window');
   end
@@ -47,7 +63,8 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
   if ~isstruct(opts) || ~isscalar(opts)
     error('fricont:argument', 'fricont_trace: opts must be a scalar struct');
   end
-  valid = {'gap', 'r', 'storage', 'max_steps', 'zero_tol', 'guess'};
+  valid = {'gap', 'r', 'storage', 'max_steps', 'zero_tol', 'guess', 'max_alpha_step', ...
+           'monitor'};
   unknown = setdiff(fieldnames(opts), valid);
   if ~isempty(unknown)
     error('fricont:argument', 'fricont_trace: unknown option ''%s''; the options are: %s', ...
@@ -55,6 +72,13 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
   end
   if ~isnumeric(window) || numel(window) ~= 2
     error('fricont:argument', 'fricont_trace: the window is [alpha_start alpha_end]');
+  end
+  monitor = [];
+  if isfield(opts, 'monitor')
+    monitor = opts.monitor;
+    if ~isempty(monitor) && ~isa(monitor, 'function_handle')
+      error('fricont:argument', 'fricont_trace: opts.monitor must be a function handle or []');
+    end
   end
   storage = 'full';
   if isfield(opts, 'storage')
@@ -94,12 +118,19 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
   if isfield(opts, 'zero_tol')
     fricont_mex('path_set', id, 'zero_tol', double(opts.zero_tol));
   end
+  if isfield(opts, 'max_alpha_step')
+    h = opts.max_alpha_step;
+    if ~isnumeric(h) || ~isreal(h) || ~isscalar(h)
+      error('fricont:argument', 'fricont_trace: max_alpha_step must be a real scalar');
+    end
+    fricont_mex('path_set', id, 'max_alpha_step', double(h));
+  end
   guess = [];
   if isfield(opts, 'guess')
     guess = full(double(opts.guess(:)));
   end
   fricont_drive(id, load, n, 'start', double(window(1)), guess);
-  fricont_drive(id, load, n, 'run');
+  fricont_drive(id, load, n, 'run', monitor);
 
   res = fricont_mex('path_result', id);
   res.r = r;

@@ -5,6 +5,9 @@
 # it traces (affine load; load function handles with and without derivative; A given as
 # its lower triangle) must equal those of the C interface (tests-install/trace_case.c),
 # and so must the transition table printed by the example matlab/examples/trace_sample.m.
+# test_fricont.m itself checks monitors (a stop after 3 transition points against the
+# unmonitored run, fricont_resume, errors in the monitor) and max_alpha_step (a narrow
+# load bump at its analytic alpha).
 # fricont_build() is also run from an installed copy (scripts/install.sh).
 source "$(dirname "$0")/../tests-install/common.sh"
 

@@ -186,7 +186,189 @@ function failures = test_fricont(case_dir, out_dir)
   failures = failures + check('a load request reaches MATLAB', strcmp(what, 'f') && value == win(1), what);
   fricont_mex('free', id);
   failures = failures + check('abandoned request: handle freed', fricont_mex('count') == 0);
+
+  % 11. A monitor that stops the path after 3 transition points: end reason 'stopped',
+  %    the events so far are the first events of the unmonitored run (section 1, the
+  %    same arithmetic: equal bits); each call gets the alpha, the count and the range
+  %    (from 1) of the new events. fricont_resume runs it on to the unmonitored run's
+  %    end and events.
+  calls = zeros(0, 4);
+  function stop = stop_at_3(a, t, first, last)
+    calls(end + 1, :) = [a t first last];
+    stop = t >= 3;
+  end
+  opts_m = opts;
+  opts_m.monitor = @stop_at_3;
+  ms = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts_m);
+  failures = failures + check('monitor: true ends the path as ''stopped''', ...
+                    strcmp(ms.end_reason, 'stopped'), ms.end_reason);
+  failures = failures + check('monitor: called after transition points 1, 2, 3', ...
+                    isequal(calls(:, 2).', 1:3), mat2str(calls));
+  ok = ~isempty(calls) && calls(1, 3) == 1 && all(calls(2:end, 3) == calls(1:end-1, 4) + 1) && ...
+       all(calls(:, 4) >= calls(:, 3)) && numel(ms.events) == calls(end, 4);
+  for k = 1:size(calls, 1)
+    for j = calls(k, 3):min(calls(k, 4), numel(ev))
+      ok = ok && ev(j).alpha == calls(k, 1) && ev(j).transition == calls(k, 2);
+    end
+  end
+  failures = failures + check('monitor: its events are res.events(first:last), at its alpha', ok, ...
+                    mat2str(calls, 17));
+  failures = failures + check('monitor: the events so far are the first of the unmonitored run', ...
+                    same_events(ms.events, ev(1:min(end, numel(ms.events)))) && ...
+                    numel(ms.events) < numel(ev));
+  calls = zeros(0, 4);
+  ms2 = fricont_resume(ms, @stop_at_3);          % true from transition 3 on: stops at 4
+  failures = failures + check('fricont_resume with a monitor: stops at the next transition point', ...
+                    strcmp(ms2.end_reason, 'stopped') && isequal(calls(:, 2).', 4) && ...
+                    same_events(ms2.events, ev(1:calls(end, 4))), mat2str(calls));
+  ms2 = fricont_resume(ms2);
+  failures = failures + check('fricont_resume: the unmonitored run''s end and events', ...
+                    strcmp(ms2.end_reason, 'window') && same_events(ms2.events, ev) && ...
+                    numel(ms2.pieces) == numel(ev) + 1, ms2.end_reason);
+  failures = failures + check('fricont_resume of an ended path: unchanged', ...
+                    same_events(getfield(fricont_resume(ms2), 'events'), ev));
+  failures = failures + check('the stopped struct keeps its events, shares the path', ...
+                    numel(ms.events) == 3 && ...
+                    ~isempty(fricont_solutions_at(ms, (ev(end).alpha + c.alpha_end) / 2)));
+  % A load function and a monitor in one run (both answered by MATLAB).
+  calls = zeros(0, 4);
+  opts_h = opts_m;
+  mh = fricont_trace(c.A, c.N, c.T, @(s) c.f0 + sinh(s) * c.f1, [], c.F, asinh(win), opts_h);
+  failures = failures + check('monitor with a load function: stops after 3, at asinh of the events', ...
+                    strcmp(mh.end_reason, 'stopped') && numel(mh.events) == 3 && ...
+                    max(abs(sinh([mh.events.alpha]) - [ev(1:3).alpha])) <= 1e-9 && ...
+                    isequal(calls(:, 2).', 1:3));
+  % A function without output arguments only watches; 1 and 0 are accepted.
+  counted = 0;
+  function watch(a, t, first, last)
+    counted = t;
+  end
+  opts_m.monitor = @watch;
+  mw = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts_m);
+  failures = failures + check('monitor without output: never stops, sees every transition point', ...
+                    strcmp(mw.end_reason, 'window') && counted == ev(end).transition);
+  opts_m.monitor = @(a, t, first, last) double(t == 2);
+  mw = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts_m);
+  failures = failures + check('monitor returning 1: stops', strcmp(mw.end_reason, 'stopped') && ...
+                    mw.events(end).transition == 2);
+  clear ms ms2 mh mw;
+  failures = failures + check('monitored paths freed when the structs are cleared', fricont_mex('count') == 0);
+
+  % 12. An error in the monitor stops the path and reaches the caller as it was raised;
+  %    nothing is left allocated. Other values than true/false/1/0 are an error; a
+  %    monitor that calls into its own path gets a clear error (not an abandoned run).
+  opts_m.monitor = @(a, t, first, last) monitor_fails(t);
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts_m));
+  failures = failures + check('monitor error: raised with its identifier and message', ...
+                    strcmp(ident, 'test:monitor') && strcmp(msg, 'monitor gives up at transition 2'), ...
+                    [ident ' ' msg]);
+  failures = failures + check('monitor error: nothing left allocated', fricont_mex('count') == 0);
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, @(s) c.f0 + s * c.f1, [], c.F, win, opts_m));
+  failures = failures + check('monitor error with a load function: raised, nothing left allocated', ...
+                    strcmp(ident, 'test:monitor') && fricont_mex('count') == 0, [ident ' ' msg]);
+  opts_m.monitor = @(a, t, first, last) 2;
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts_m));
+  failures = failures + check('monitor returning 2: an error saying what it must return', ...
+                    strcmp(ident, 'fricont:monitor') && ~isempty(strfind(msg, 'true (stop) or false')), msg);
+  opts_m.monitor = 'stop';
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts_m));
+  failures = failures + check('opts.monitor not a function: fricont:argument', ...
+                    strcmp(ident, 'fricont:argument') && ~isempty(strfind(msg, 'monitor')), msg);
+  opts_m.monitor = @(a, t, first, last) t >= 1;
+  ms = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts_m);
+  [ident, msg] = caught(@() fricont_resume(ms, @(a, t, first, last) isempty(fricont_solutions_at(ms, a))));
+  failures = failures + check('monitor calling into its own path: fricont:order, the path stopped', ...
+                    strcmp(ident, 'fricont:order') && ~isempty(strfind(msg, 'in use')) && ...
+                    same_events(getfield(fricont_mex('path_result', ms.handle.id), 'events'), ...
+                                ev(1:find([ev.transition] == 2, 1, 'last'))), [ident ' ' msg]);
+  clear ms;
+  % A monitor request MATLAB leaves unanswered (Ctrl-C in the monitor: fricont_drive's
+  % onCleanup then calls 'settle'): the path is in use until then, and stopped after.
+  prob = fricont_mex('problem_new', c.A, 'full', c.N.', c.T.');
+  fricont_mex('problem_set', prob, 'friction', c.F);
+  fricont_mex('problem_set', prob, 'gap', c.gap);
+  id = fricont_mex('path_new_affine', prob, c.f0, c.f1);
+  fricont_mex('free', prob);
+  fricont_mex('path_set', id, 'window', win);
+  fricont_mex('path_call', id, 'start', win(1), []);
+  [what, value] = fricont_mex('path_call', id, 'run', 1);
+  k1 = sum([ev.transition] == 1);
+  failures = failures + check('a monitor request reaches MATLAB: [alpha 1 1 last]', ...
+                    strcmp(what, 'monitor') && isequal(value, [ev(1).alpha 1 1 k1]), mat2str(value, 17));
+  ident = caught(@() fricont_mex('path_result', id));
+  failures = failures + check('while it is pending the path is in use', strcmp(ident, 'fricont:order'), ident);
+  fricont_mex('settle', id);
+  r = fricont_mex('path_result', id);
+  failures = failures + check('settled: the run stopped after the first transition point', ...
+                    strcmp(r.end_reason, 'stopped') && same_events(r.events, ev(1:k1)), r.end_reason);
+  fricont_mex('free', id);
+  failures = failures + check('every handle freed after the monitor errors', fricont_mex('count') == 0);
+
+  % 13. max_alpha_step: one node, A = I, N = [1 0], T = [0 1], F = 0.3, normal load
+  %    0.5 - 0.6 exp(-((alpha - ab)/w)^2): the node opens where the exponential exceeds
+  %    5/6, i.e. for |alpha - ab| < w sqrt(log(1.2)) (by hand). Steps of at most 1e-3
+  %    find both transitions there; the default steps (up to 1/8 of the window) never
+  %    evaluate the load on the bump. Bad values are errors for every kind of load.
+  ab = 21.5 / 64;
+  w = 2e-3;
+  half = w * sqrt(log(1.2));
+  bump = @(a) [0.5 - 0.6 * exp(-((a - ab) / w)^2); 0];
+  A1 = speye(2);
+  N1 = sparse([1 0]);
+  T1 = sparse([0 1]);
+  pb = fricont_trace(A1, N1, T1, bump, [], 0.3, [-1 1], struct('max_alpha_step', 1e-3));
+  ok = strcmp(pb.end_reason, 'window') && numel(pb.events) == 2;
+  if ok
+    ok = strcmp(pb.events(1).from, 'stick') && strcmp(pb.events(1).to, 'open') && ...
+         strcmp(pb.events(2).from, 'open') && strcmp(pb.events(2).to, 'stick') && ...
+         all([pb.events.node] == 1) && abs(pb.events(1).alpha - (ab - half)) <= 1e-10 && ...
+         abs(pb.events(2).alpha - (ab + half)) <= 1e-10;
+  end
+  failures = failures + check('max_alpha_step 1e-3: the bump''s two transitions at ab -/+ w sqrt(log 1.2)', ...
+                    ok, sprintf('%s, alphas %s', pb.end_reason, mat2str([pb.events.alpha], 15)));
+  pd = fricont_trace(A1, N1, T1, bump, [], 0.3, [-1 1]);
+  failures = failures + check('default steps: the bump is stepped over (so the option took effect)', ...
+                    isempty(pd.events));
+  bad = {0, -1, NaN, Inf};
+  ok = true;
+  why = '';
+  for k = 1:numel(bad)
+    for kind = {'function', 'affine'}
+      if strcmp(kind{1}, 'function')
+        [ident, msg] = caught(@() fricont_trace(A1, N1, T1, bump, [], 0.3, [-1 1], ...
+                                                struct('max_alpha_step', bad{k})));
+      else
+        [ident, msg] = caught(@() fricont_trace(A1, N1, T1, [0.5; 0], [0; 0], 0.3, [-1 1], ...
+                                                struct('max_alpha_step', bad{k})));
+      end
+      if ~strcmp(ident, 'fricont:ERR_RANGE') || isempty(strfind(msg, 'max_alpha_step'))
+        ok = false;
+        why = [why sprintf('%g (%s): %s %s; ', bad{k}, kind{1}, ident, msg)];
+      end
+    end
+  end
+  failures = failures + check('max_alpha_step 0, -1, NaN, Inf: fricont:ERR_RANGE naming it', ok, why);
+  [ident, msg] = caught(@() fricont_trace(A1, N1, T1, bump, [], 0.3, [-1 1], ...
+                                          struct('max_alpha_step', [1e-3 1e-2])));
+  failures = failures + check('max_alpha_step not a scalar: fricont:argument naming it', ...
+                    strcmp(ident, 'fricont:argument') && ~isempty(strfind(msg, 'max_alpha_step')), msg);
+  clear pb pd;
+  failures = failures + check('every handle freed after the max_alpha_step cases', fricont_mex('count') == 0);
   fprintf('matlab test_fricont: %d failed check(s)\n', failures);
+end
+
+function stop = monitor_fails(t)
+  if t == 2
+    error('test:monitor', 'monitor gives up at transition %d', t);
+  end
+  stop = false;
+end
+
+% Same alpha (bits), node, classes and transition, event by event.
+function same = same_events(a, b)
+  same = numel(a) == numel(b) && isequal([a.alpha], [b.alpha]) && isequal([a.node], [b.node]) && ...
+         isequal({a.from}, {b.from}) && isequal({a.to}, {b.to}) && ...
+         isequal([a.transition], [b.transition]);
 end
 
 % The identifier and message of the error fn() raises ('' if none).
