@@ -10,7 +10,8 @@
 //! * the high-friction variant has a fold, and the several solutions it reports at one α
 //!   are distinct genuine solutions;
 //! * the figures are fit for print (text size at 16 cm, a PNG beside each SVG, legends
-//!   off the data and only for what is drawn, a zoom that contains what it zooms on).
+//!   off the data and only for what is drawn, a zoom that contains what it zooms on);
+//! * the numbers quoted in `docs/case-study.md` and the README are the computed ones.
 
 use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
@@ -20,6 +21,7 @@ use fricont::{Class, EndReason};
 use fricont_cli::casestudy::{CaseStudyOptions, CaseStudyReport, PxRect, run};
 use fricont_exchange::generator::{RectSpec, generate};
 use fricont_exchange::io::CaseData;
+use fricont_exchange::report::fmt_alpha;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("fricont-{name}-{}", std::process::id()));
@@ -786,5 +788,99 @@ fn figures_are_fit_for_print() {
         .filter_map(|s| s.trim().parse().ok())
         .collect();
     assert_eq!(named, inside, "the zoom's title: {title}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Collapses every run of whitespace to one space.
+fn squash(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[test]
+fn documented_numbers_are_the_computed_ones() {
+    let (out, report) = run_case_study("cs-docs");
+    let repo = FsPath::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let doc = std::fs::read_to_string(repo.join("docs/case-study.md")).unwrap();
+    let readme = std::fs::read_to_string(repo.join("README.md")).unwrap();
+    // the table of docs/case-study.md is the one printed, line for line
+    let table = |s: &str| -> Vec<String> {
+        s.lines()
+            .map(str::trim)
+            .filter(|l| l.starts_with("at transition point "))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(
+        table(&doc),
+        table(&report.table),
+        "docs/case-study.md's table is not the output of `fricont case-study`:\n{}",
+        table(&report.table).join("\n")
+    );
+    // every other number quoted, to its printed digits
+    let main = |k: usize| {
+        let t = &report.transitions[k - 1];
+        assert_eq!(t.transition, k);
+        t.alpha
+    };
+    let fr = report.fold.as_ref().unwrap();
+    let hf = |k: usize| {
+        let t = fr.transitions.iter().find(|t| t.transition == k).unwrap();
+        assert!(t.fold, "transition {k} is quoted as a fold");
+        t.alpha
+    };
+    let query = fr.alpha_query.unwrap();
+    let folds = fr.transitions.iter().filter(|t| t.fold).count();
+    let quotes_doc = [
+        format!("({:.3}, {:.3}, {:.3} against", main(6), main(7), main(8)),
+        format!("transition point 29 (α = {})", fmt_alpha(hf(29))),
+        format!("α = {} (transition 30, a second fold)", fmt_alpha(hf(30))),
+        format!("until {} (transition 38)", fmt_alpha(hf(38))),
+        format!("until {} (transition 46)", fmt_alpha(hf(46))),
+        format!("{folds} folds in all"),
+        format!("On ({:.4}, {:.4})", hf(46), hf(38)),
+        format!("(α = {})", fmt_alpha(query)),
+        format!("all **{} solutions**", fr.solutions),
+    ];
+    let quotes_readme = [
+        format!(
+            "at α = {:.3}, {:.3}, {:.3} (the paper",
+            main(6),
+            main(7),
+            main(8)
+        ),
+        format!(
+            "{folds} folds, with all {} solutions at α = {:.3} drawn",
+            fr.solutions, query
+        ),
+        format!("has {} transition points", report.transitions.len()),
+    ];
+    let (sdoc, sreadme) = (squash(&doc), squash(&readme));
+    for q in &quotes_doc {
+        assert!(
+            sdoc.contains(&squash(q)),
+            "docs/case-study.md should say {q:?}"
+        );
+    }
+    for q in &quotes_readme {
+        assert!(sreadme.contains(&squash(q)), "README.md should say {q:?}");
+    }
+    // no long number escapes these checks (the paper's three are its own)
+    let papers = ["0.28019791259766", "0.42934036865234", "0.60403706054688"];
+    let table_text = table(&report.table).join("\n");
+    for (file, text, quotes) in [
+        ("docs/case-study.md", &sdoc, &quotes_doc[..]),
+        ("README.md", &sreadme, &quotes_readme[..]),
+    ] {
+        for word in text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-')) {
+            let digits = word.chars().filter(char::is_ascii_digit).count();
+            if digits < 7 || word.parse::<f64>().is_err() {
+                continue;
+            }
+            let covered = papers.contains(&word)
+                || table_text.contains(word)
+                || quotes.iter().any(|q| q.contains(word));
+            assert!(covered, "{file}: {word} is checked against nothing");
+        }
+    }
     std::fs::remove_dir_all(&out).unwrap();
 }
