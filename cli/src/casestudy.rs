@@ -1,9 +1,15 @@
 //! The founding paper's case study, end to end: generate the rectangle problem
 //! ([`fricont_exchange::generator`]), write it in the exchange format, trace the path over the
 //! paper's window, and write the transition table (in the paper's words), the figures
-//! (SVG) and the path (CSV, JSON). A high-friction variant of the same geometry is traced
-//! through its non-smooth folds, and every solution at one α inside a fold region is
-//! drawn.
+//! (SVG, and a PNG beside each) and the path (CSV, JSON). A high-friction variant of the
+//! same geometry is traced through its non-smooth folds, and every solution at one α
+//! inside a fold region is drawn.
+//!
+//! The figures are laid out to be printed [`PRINT_WIDTH_CM`] wide with all text at least
+//! [`MIN_TEXT_PT`] there, legends outside the plot areas listing only what is drawn; the
+//! PNGs ([`write_png`]) are rendered with a font embedded in the program. Each drawing
+//! function returns a [`FigureLayout`] (plot areas, data and legends in pixels) that the
+//! tests check these rules on.
 //!
 //! The library never prints: [`run`] returns the text of the table in
 //! [`CaseStudyReport::table`] and the CLI (`fricont case-study --out DIR`) prints it.
@@ -22,19 +28,23 @@ use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
-use plotters::coord::Shift;
-use plotters::prelude::*;
 use serde_json::{Value, json};
 
 use fricont::class::Class;
 use fricont::path::{EndReason, Path, PathOptions, State};
 use fricont::problem::Problem;
-use fricont_exchange::generator::{RectSpec, Side, generate};
+use fricont_exchange::generator::{RectSpec, generate};
 use fricont_exchange::io::CaseData;
 use fricont_exchange::report::{
     PathReport, Timing, TransitionRow, events_csv, fmt_alpha, transition_rows,
 };
 use fricont_exchange::{Error, Result};
+
+mod figures;
+pub use figures::{
+    FIG_WIDTH, FigureLayout, MIN_TEXT_PT, PNG_DPI, PRINT_WIDTH_CM, PxRect, plot_mesh, plot_path,
+    plot_path_window, plot_profiles, plot_snapshot, plot_solutions, png_width, pt_to_px, write_png,
+};
 
 /// What to run. `CaseStudyOptions::new(out)` gives the paper's case study.
 #[derive(Debug, Clone, PartialEq)]
@@ -102,6 +112,8 @@ pub struct FoldReport {
     pub alpha_query: Option<f64>,
     /// Number of solutions found there.
     pub solutions: usize,
+    /// The α window of the zoom on the folds (`path_folds.svg`), when the path folds.
+    pub zoom: Option<(f64, f64)>,
 }
 
 /// What [`run`] did.
@@ -126,6 +138,8 @@ pub struct CaseStudyReport {
     pub trace_s: f64,
     /// Files written.
     pub files: Vec<PathBuf>,
+    /// The figures written (SVG, PNG, layout), the high-friction variant's included.
+    pub figures: Vec<Figure>,
     /// The high-friction variant, if run.
     pub fold: Option<FoldReport>,
 }
@@ -205,558 +219,8 @@ pub struct PieceLine {
     pub lambda_t_to: Vec<f64>,
 }
 
-fn plot_err<E: std::fmt::Display>(file: &FsPath) -> impl FnOnce(E) -> Error + '_ {
-    move |e| Error::Io(format!("cannot draw {}: {e}", file.display()))
-}
-
 fn io_err<E: std::fmt::Display>(file: &FsPath) -> impl FnOnce(E) -> Error + '_ {
     move |e| Error::Io(format!("cannot write {}: {e}", file.display()))
-}
-
-const FONT: &str = "sans-serif";
-const PALETTE: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(23, 190, 207),
-];
-
-fn sum(v: &[f64]) -> f64 {
-    v.iter().sum()
-}
-
-/// Data range with a margin; never empty.
-fn range(vals: impl IntoIterator<Item = f64>) -> std::ops::Range<f64> {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in vals {
-        if v.is_finite() {
-            lo = lo.min(v);
-            hi = hi.max(v);
-        }
-    }
-    if !lo.is_finite() {
-        return -1.0..1.0;
-    }
-    let span = hi - lo;
-    let pad = if span > 0.0 {
-        0.08 * span
-    } else {
-        0.1 * lo.abs().max(1e-12)
-    };
-    (lo - pad)..(hi + pad)
-}
-
-type Chart<'a, 'b> = ChartContext<
-    'a,
-    SVGBackend<'b>,
-    Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
->;
-
-/// Draws class markers (circle: no contact, diamond: stick, square: slip; filled square
-/// slip+, open square slip−) at `(x, y)`, with legend entries when `legend` is set.
-fn draw_class_markers<'a, 'b: 'a>(
-    chart: &mut Chart<'a, 'b>,
-    pts: &[(f64, f64, Class)],
-    color: RGBColor,
-    legend: bool,
-) -> std::result::Result<(), String> {
-    let filled = color.filled();
-    let hollow = color.stroke_width(2);
-    let pick = |c: Class| pts.iter().filter(move |p| p.2 == c).map(|p| (p.0, p.1));
-    let black = BLACK.stroke_width(2);
-    let a = chart
-        .draw_series(pick(Class::Open).map(|p| Circle::new(p, 4, hollow)))
-        .map_err(|e| e.to_string())?;
-    if legend {
-        a.label("no contact")
-            .legend(move |(x, y)| Circle::new((x, y), 4, black));
-    }
-    let diamond = |s: ShapeStyle| {
-        move |p: (f64, f64)| {
-            EmptyElement::at(p) + Polygon::new(vec![(0, -6), (6, 0), (0, 6), (-6, 0)], s)
-        }
-    };
-    let a = chart
-        .draw_series(pick(Class::Stick).map(diamond(filled)))
-        .map_err(|e| e.to_string())?;
-    if legend {
-        a.label("contact, stick").legend(move |(x, y)| {
-            EmptyElement::at((x, y))
-                + Polygon::new(vec![(0, -6), (6, 0), (0, 6), (-6, 0)], BLACK.filled())
-        });
-    }
-    let square = |s: ShapeStyle| {
-        move |p: (f64, f64)| EmptyElement::at(p) + Rectangle::new([(-4, -4), (4, 4)], s)
-    };
-    let a = chart
-        .draw_series(pick(Class::SlipPlus).map(square(filled)))
-        .map_err(|e| e.to_string())?;
-    if legend {
-        a.label("contact, slip (+x)").legend(move |(x, y)| {
-            EmptyElement::at((x, y)) + Rectangle::new([(-4, -4), (4, 4)], BLACK.filled())
-        });
-    }
-    let a = chart
-        .draw_series(pick(Class::SlipMinus).map(square(hollow)))
-        .map_err(|e| e.to_string())?;
-    if legend {
-        a.label("contact, slip (−x)").legend(move |(x, y)| {
-            EmptyElement::at((x, y)) + Rectangle::new([(-4, -4), (4, 4)], black)
-        });
-    }
-    Ok(())
-}
-
-/// Tick label for an axis spanning `span`: one format per axis (decimals when the span
-/// is between 0.01 and 1e5, scientific otherwise), no "-0".
-fn tick(v: f64, span: f64) -> String {
-    if v.abs() <= 1e-9 * span {
-        return "0".into();
-    }
-    if (0.01..1e5).contains(&span) {
-        let digits = (2 - span.log10().floor() as i32).clamp(0, 8) as usize;
-        let t = format!("{v:.digits$}");
-        if t.contains('.') {
-            t.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            t
-        }
-    } else {
-        format!("{v:.1e}")
-    }
-}
-
-/// An entry of a legend strip.
-enum Entry {
-    /// A class marker (black) with its words.
-    Class(Class),
-    /// A coloured line with a label.
-    Line(RGBColor, String),
-}
-
-/// Draws a horizontal legend strip (below the panels) in pixel coordinates.
-fn legend_strip(
-    area: &DrawingArea<SVGBackend<'_>, Shift>,
-    entries: &[Entry],
-) -> std::result::Result<(), String> {
-    let (w, h) = area.dim_in_pixel();
-    let font = (FONT, 15).into_font();
-    let widths: Vec<i32> = entries
-        .iter()
-        .map(|e| match e {
-            Entry::Class(c) => 40 + 8 * class_label(*c).chars().count() as i32,
-            Entry::Line(_, l) => 40 + 8 * l.chars().count() as i32,
-        })
-        .collect();
-    let total: i32 = widths.iter().sum();
-    let mut x = ((w as i32 - total) / 2).max(10);
-    let y = h as i32 / 2;
-    let e = |err: plotters::drawing::DrawingAreaErrorKind<_>| err.to_string();
-    for (entry, wd) in entries.iter().zip(&widths) {
-        match entry {
-            Entry::Class(c) => {
-                let black = BLACK.stroke_width(2);
-                match c {
-                    Class::Open => area.draw(&Circle::new((x + 8, y), 5, black)).map_err(e)?,
-                    Class::Stick => area
-                        .draw(&Polygon::new(
-                            vec![(x + 8, y - 7), (x + 15, y), (x + 8, y + 7), (x + 1, y)],
-                            BLACK.filled(),
-                        ))
-                        .map_err(e)?,
-                    Class::SlipPlus => area
-                        .draw(&Rectangle::new(
-                            [(x + 3, y - 5), (x + 13, y + 5)],
-                            BLACK.filled(),
-                        ))
-                        .map_err(e)?,
-                    Class::SlipMinus => area
-                        .draw(&Rectangle::new([(x + 3, y - 5), (x + 13, y + 5)], black))
-                        .map_err(e)?,
-                }
-                area.draw(&Text::new(class_label(*c), (x + 24, y - 8), font.clone()))
-                    .map_err(e)?;
-            }
-            Entry::Line(color, l) => {
-                area.draw(&PathElement::new(
-                    vec![(x, y), (x + 22, y)],
-                    color.stroke_width(3),
-                ))
-                .map_err(e)?;
-                area.draw(&Text::new(l.as_str(), (x + 28, y - 8), font.clone()))
-                    .map_err(e)?;
-            }
-        }
-        x += wd;
-    }
-    Ok(())
-}
-
-/// The paper's marker words for a class.
-fn class_label(c: Class) -> &'static str {
-    match c {
-        Class::Open => "no contact (circle)",
-        Class::Stick => "contact, stick (diamond)",
-        Class::SlipPlus => "contact, slip +x (square)",
-        Class::SlipMinus => "contact, slip −x (open square)",
-    }
-}
-
-fn class_entries() -> Vec<Entry> {
-    Class::ALL.iter().map(|&c| Entry::Class(c)).collect()
-}
-
-/// One panel: values against node index with class markers.
-fn node_panel(
-    area: &DrawingArea<SVGBackend<'_>, Shift>,
-    title: &str,
-    ylabel: &str,
-    series: &[(&[f64], &[Class], RGBColor)],
-) -> std::result::Result<(), String> {
-    let p = series.first().map_or(1, |s| s.0.len());
-    let yr = range(series.iter().flat_map(|s| s.0.iter().copied()).chain([0.0]));
-    let span = yr.end - yr.start;
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 18))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(75)
-        .build_cartesian_2d(0.5..p as f64 + 0.5, yr)
-        .map_err(|e| e.to_string())?;
-    let xt = |v: &f64| format!("{}", v.round() as i64);
-    let yt = |v: &f64| tick(*v, span);
-    chart
-        .configure_mesh()
-        .x_desc("contact node i (1 = next to the clamped side)")
-        .y_desc(ylabel)
-        .x_labels(p.min(16))
-        .x_label_formatter(&xt)
-        .y_label_formatter(&yt)
-        .light_line_style(WHITE.mix(0.0))
-        .label_style((FONT, 13))
-        .axis_desc_style((FONT, 14))
-        .draw()
-        .map_err(|e| e.to_string())?;
-    chart
-        .draw_series(LineSeries::new(
-            [(0.5, 0.0), (p as f64 + 0.5, 0.0)],
-            BLACK.mix(0.3),
-        ))
-        .map_err(|e| e.to_string())?;
-    for (vals, classes, color) in series {
-        chart
-            .draw_series(LineSeries::new(
-                vals.iter().enumerate().map(|(i, &v)| ((i + 1) as f64, v)),
-                color.mix(0.6).stroke_width(1),
-            ))
-            .map_err(|e| e.to_string())?;
-        let pts: Vec<(f64, f64, Class)> = vals
-            .iter()
-            .zip(classes.iter())
-            .enumerate()
-            .map(|(i, (&v, &c))| ((i + 1) as f64, v, c))
-            .collect();
-        draw_class_markers(&mut chart, &pts, *color, false)?;
-    }
-    Ok(())
-}
-
-/// Figure 2: λν, λt, uν, ut at the contact nodes for one point, markers by class.
-pub fn plot_snapshot(data: &ContactData, title: &str, file: &FsPath) -> Result<()> {
-    let root = SVGBackend::new(file, (1200, 950)).into_drawing_area();
-    let draw = || -> std::result::Result<(), String> {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let root = root.titled(title, (FONT, 22)).map_err(|e| e.to_string())?;
-        let (h, _) = (root.dim_in_pixel().1, ());
-        let (panels, strip) = root.split_vertically(h - 45);
-        let areas = panels.split_evenly((2, 2));
-        let c = &data.classes;
-        let blue = PALETTE[0];
-        node_panel(
-            &areas[0],
-            "normal contact force λν (≤ 0: compression)",
-            "λν  [E·L]",
-            &[(&data.lambda_n, c, blue)],
-        )?;
-        node_panel(
-            &areas[1],
-            "tangential contact force λt (along +x)",
-            "λt  [E·L]",
-            &[(&data.lambda_t, c, blue)],
-        )?;
-        node_panel(
-            &areas[2],
-            "normal displacement uν = −u_y (< 0: lifted off)",
-            "uν  [L]",
-            &[(&data.u_n, c, blue)],
-        )?;
-        node_panel(
-            &areas[3],
-            "tangential displacement ut = u_x",
-            "ut  [L]",
-            &[(&data.u_t, c, blue)],
-        )?;
-        legend_strip(&strip, &class_entries())?;
-        root.present().map_err(|e| e.to_string())
-    };
-    draw().map_err(plot_err(file))
-}
-
-/// Figure 3: λν against the node index for several points, markers by class.
-pub fn plot_profiles(list: &[ContactData], title: &str, file: &FsPath) -> Result<()> {
-    let root = SVGBackend::new(file, (1100, 760)).into_drawing_area();
-    let draw = || -> std::result::Result<(), String> {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let h = root.dim_in_pixel().1;
-        let (panel, strips) = root.split_vertically(h - 80);
-        let (strip1, strip2) = strips.split_vertically(40);
-        let series: Vec<(&[f64], &[Class], RGBColor)> = list
-            .iter()
-            .enumerate()
-            .map(|(k, d)| {
-                (
-                    d.lambda_n.as_slice(),
-                    d.classes.as_slice(),
-                    PALETTE[k % PALETTE.len()],
-                )
-            })
-            .collect();
-        node_panel(&panel, title, "λν  [E·L]", &series)?;
-        let lines: Vec<Entry> = list
-            .iter()
-            .enumerate()
-            .map(|(k, d)| Entry::Line(PALETTE[k % PALETTE.len()], format!("α = {}", d.alpha)))
-            .collect();
-        legend_strip(&strip1, &lines)?;
-        legend_strip(&strip2, &class_entries())?;
-        root.present().map_err(|e| e.to_string())
-    };
-    draw().map_err(plot_err(file))
-}
-
-/// Figure 1: the mesh, with the clamped side, the contact side and the loaded sides.
-pub fn plot_mesh(spec: &RectSpec, file: &FsPath) -> Result<()> {
-    let (lx, ly) = (spec.lx, spec.ly);
-    let pad = 0.22 * lx.max(ly);
-    let top_pad = 0.45 * lx.max(ly);
-    // equal scales on both axes: plot width ≈ 1100 − 60 (labels) − 30 (margins)
-    let px_per_l = 1010.0 / (lx + 2.0 * pad);
-    let height = ((ly + pad + top_pad) * px_per_l + 120.0).clamp(300.0, 2000.0) as u32;
-    let root = SVGBackend::new(file, (1100, height)).into_drawing_area();
-    let draw = || -> std::result::Result<(), String> {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(
-                format!(
-                    "Case study mesh: Q1, {}×{} nodes, n = {}, p = {}",
-                    spec.nx,
-                    spec.ny,
-                    spec.n(),
-                    spec.p()
-                ),
-                (FONT, 22),
-            )
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
-            .build_cartesian_2d(-pad..lx + pad, -pad..ly + top_pad)
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_desc("x  [L]")
-            .y_desc("y  [L]")
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 15))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        let (hx, hy) = spec.h();
-        let grey = RGBColor(150, 150, 150).stroke_width(1);
-        for i in 0..spec.nx {
-            let x = i as f64 * hx;
-            chart
-                .draw_series(LineSeries::new([(x, 0.0), (x, ly)], grey))
-                .map_err(|e| e.to_string())?;
-        }
-        for j in 0..spec.ny {
-            let y = j as f64 * hy;
-            chart
-                .draw_series(LineSeries::new([(0.0, y), (lx, y)], grey))
-                .map_err(|e| e.to_string())?;
-        }
-        // clamped side: thick line with hatching
-        let clamp = RGBColor(60, 60, 60);
-        chart
-            .draw_series(LineSeries::new(
-                [(0.0, 0.0), (0.0, ly)],
-                clamp.stroke_width(4),
-            ))
-            .map_err(|e| e.to_string())?
-            .label("clamped side (u = 0)")
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x - 8, y), (x + 12, y)], clamp.stroke_width(4))
-            });
-        let nh = 14;
-        for k in 0..=nh {
-            let y = ly * k as f64 / nh as f64;
-            chart
-                .draw_series(LineSeries::new(
-                    [(0.0, y), (-0.06 * lx, y - 0.06 * lx)],
-                    clamp.stroke_width(1),
-                ))
-                .map_err(|e| e.to_string())?;
-        }
-        // foundation and contact nodes
-        let found = RGBColor(140, 90, 40);
-        chart
-            .draw_series(LineSeries::new(
-                [(-0.02 * lx, 0.0), (lx + 0.05 * lx, 0.0)],
-                found.stroke_width(2),
-            ))
-            .map_err(|e| e.to_string())?
-            .label("rigid foundation")
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x - 8, y), (x + 12, y)], found.stroke_width(2))
-            });
-        for k in 0..=2 * spec.nx {
-            let x = lx * 1.05 * k as f64 / (2 * spec.nx) as f64 - 0.02 * lx;
-            chart
-                .draw_series(LineSeries::new(
-                    [(x, 0.0), (x - 0.03 * lx, -0.04 * lx)],
-                    found.stroke_width(1),
-                ))
-                .map_err(|e| e.to_string())?;
-        }
-        let red = PALETTE[3];
-        chart
-            .draw_series(
-                (0..spec.p()).map(|i| Circle::new((spec.contact_x(i), 0.0), 4, red.filled())),
-            )
-            .map_err(|e| e.to_string())?
-            .label(format!("contact nodes i = 1..{} (Γ_C)", spec.p()))
-            .legend(move |(x, y)| Circle::new((x, y), 4, red.filled()));
-        for i in [0, spec.p() / 2, spec.p() - 1] {
-            chart
-                .draw_series([Text::new(
-                    format!("{}", i + 1),
-                    (spec.contact_x(i) - 0.3 * hx, -0.11 * lx),
-                    (FONT, 13).into_font().color(&red),
-                )])
-                .map_err(|e| e.to_string())?;
-        }
-        // tractions: arrows at a few points of each loaded side
-        let arrow_len = 0.12 * lx.max(ly);
-        let loads = [
-            (&spec.load0, PALETTE[0], "f0"),
-            (&spec.load1, PALETTE[2], "α·f1"),
-        ];
-        for (li, (tracs, color, name)) in loads.into_iter().enumerate() {
-            let maxmag = tracs
-                .iter()
-                .flat_map(|t| [t.start, t.end])
-                .map(|v| v[0].hypot(v[1]))
-                .fold(0.0, f64::max);
-            if maxmag == 0.0 {
-                continue;
-            }
-            let mut first = true;
-            for t in tracs.iter() {
-                // f0 arrows at the ends and every eighth of the side, α·f1 arrows halfway
-                // between them, so the two loads do not hide each other
-                let m = 8;
-                for k in 0..=(m - li) {
-                    let s = (k as f64 + 0.5 * li as f64) / m as f64;
-                    let (x, y) = match t.side {
-                        Side::Bottom => (s * lx, 0.0),
-                        Side::Top => (s * lx, ly),
-                        Side::Left => (0.0, s * ly),
-                        Side::Right => (lx, s * ly),
-                    };
-                    let v = [
-                        t.start[0] * (1.0 - s) + t.end[0] * s,
-                        t.start[1] * (1.0 - s) + t.end[1] * s,
-                    ];
-                    let mag = v[0].hypot(v[1]);
-                    if mag < 1e-3 * maxmag {
-                        continue;
-                    }
-                    let sc = arrow_len / maxmag;
-                    // arrows end on the boundary for pushing loads, start on it otherwise
-                    let out = match t.side {
-                        Side::Top => [0.0, 1.0],
-                        Side::Bottom => [0.0, -1.0],
-                        Side::Left => [-1.0, 0.0],
-                        Side::Right => [1.0, 0.0],
-                    };
-                    let normal = v[0] * out[0] + v[1] * out[1];
-                    let pushing = normal < 0.0;
-                    // mainly tangential tractions are drawn a little outside the side
-                    let (x, y) = if normal.abs() < 0.5 * mag {
-                        let off = 0.05 * lx.max(ly);
-                        (x + off * out[0], y + off * out[1])
-                    } else {
-                        (x, y)
-                    };
-                    let (x0, y0, x1, y1) = if pushing {
-                        (x - v[0] * sc, y - v[1] * sc, x, y)
-                    } else {
-                        (x, y, x + v[0] * sc, y + v[1] * sc)
-                    };
-                    let a = chart
-                        .draw_series(LineSeries::new([(x0, y0), (x1, y1)], color.stroke_width(2)))
-                        .map_err(|e| e.to_string())?;
-                    if first {
-                        let lab = format!(
-                            "{name}: {}",
-                            tracs
-                                .iter()
-                                .map(|t| format!(
-                                    "{} ({}, {}) → ({}, {})",
-                                    t.side.name(),
-                                    t.start[0],
-                                    t.start[1],
-                                    t.end[0],
-                                    t.end[1]
-                                ))
-                                .collect::<Vec<_>>()
-                                .join("; ")
-                        );
-                        a.label(lab).legend(move |(x, y)| {
-                            PathElement::new(vec![(x - 8, y), (x + 12, y)], color.stroke_width(2))
-                        });
-                        first = false;
-                    }
-                    // arrow head
-                    let (dx, dy) = (x1 - x0, y1 - y0);
-                    let l = dx.hypot(dy);
-                    let (ux, uy) = (dx / l, dy / l);
-                    let hl = 0.025 * lx.max(ly);
-                    let head = [
-                        (x1 - hl * ux + 0.5 * hl * uy, y1 - hl * uy - 0.5 * hl * ux),
-                        (x1, y1),
-                        (x1 - hl * ux - 0.5 * hl * uy, y1 - hl * uy + 0.5 * hl * ux),
-                    ];
-                    chart
-                        .draw_series(LineSeries::new(head, color.stroke_width(2)))
-                        .map_err(|e| e.to_string())?;
-                }
-            }
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK.mix(0.5))
-            .label_font((FONT, 13))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())
-    };
-    draw().map_err(plot_err(file))
 }
 
 /// A transition point as drawn on the path figure.
@@ -776,291 +240,30 @@ pub struct MarkedPoint {
     pub node: usize,
 }
 
-/// The path figure: top, the total contact forces `Σλν`, `Σλt` against α; bottom, `λν`
-/// of the nodes in `nodes` (0-based) against α. Transition points are marked and
-/// numbered; folds (α turning back) get a red triangle.
-pub fn plot_path(
-    pieces: &[PieceLine],
-    points: &[MarkedPoint],
-    nodes: &[usize],
-    title: &str,
-    file: &FsPath,
-) -> Result<()> {
-    let root = SVGBackend::new(file, (1200, 1000)).into_drawing_area();
-    let draw = || -> std::result::Result<(), String> {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let root = root.titled(title, (FONT, 22)).map_err(|e| e.to_string())?;
-        let (top, bottom) = root.split_vertically(470);
-        let ar = range(pieces.iter().flat_map(|p| [p.alpha_from, p.alpha_to]));
-        // top panel
-        let yr = range(pieces.iter().flat_map(|p| {
-            [
-                sum(&p.lambda_n_from),
-                sum(&p.lambda_n_to),
-                sum(&p.lambda_t_from),
-                sum(&p.lambda_t_to),
-                0.0,
-            ]
-        }));
-        let yspan = yr.end - yr.start;
-        let mut chart = ChartBuilder::on(&top)
-            .caption("total contact forces along the path", (FONT, 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(75)
-            .build_cartesian_2d(ar.clone(), yr.clone())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("load parameter α  [–]")
-            .y_desc("Σ λ  [E·L]")
-            .y_label_formatter(&|v: &f64| tick(*v, yspan))
-            .light_line_style(WHITE.mix(0.0))
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (k, (name, getf, gett)) in [
-            (
-                "Σ λν (normal)",
-                (|p: &PieceLine| sum(&p.lambda_n_from)) as fn(&PieceLine) -> f64,
-                (|p: &PieceLine| sum(&p.lambda_n_to)) as fn(&PieceLine) -> f64,
-            ),
-            (
-                "Σ λt (tangential)",
-                |p: &PieceLine| sum(&p.lambda_t_from),
-                |p: &PieceLine| sum(&p.lambda_t_to),
-            ),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let c = PALETTE[k];
-            let mut first = true;
-            for p in pieces {
-                let a = chart
-                    .draw_series(LineSeries::new(
-                        [(p.alpha_from, getf(p)), (p.alpha_to, gett(p))],
-                        c.stroke_width(2),
-                    ))
-                    .map_err(|e| e.to_string())?;
-                if first {
-                    a.label(name).legend(move |(x, y)| {
-                        PathElement::new(vec![(x - 8, y), (x + 12, y)], c.stroke_width(3))
-                    });
-                    first = false;
-                }
-            }
-            draw_points(
-                &mut chart,
-                points,
-                |m| {
-                    (
-                        m.alpha,
-                        if k == 0 {
-                            sum(&m.lambda_n)
-                        } else {
-                            sum(&m.lambda_t)
-                        },
-                    )
-                },
-                (k == 0).then_some(ar.end - ar.start),
-            )?;
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.5))
-            .label_font((FONT, 13))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        // bottom panel
-        let yr = range(pieces.iter().flat_map(|p| {
-            nodes
-                .iter()
-                .flat_map(|&i| [p.lambda_n_from[i], p.lambda_n_to[i]])
-                .chain([0.0])
-                .collect::<Vec<_>>()
-        }));
-        let yspan = yr.end - yr.start;
-        let mut chart = ChartBuilder::on(&bottom)
-            .caption("normal contact force of selected nodes", (FONT, 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(75)
-            .build_cartesian_2d(ar, yr.clone())
-            .map_err(|e| e.to_string())?;
-        chart
-            .configure_mesh()
-            .x_desc("load parameter α  [–]")
-            .y_desc("λν_i  [E·L]")
-            .y_label_formatter(&|v: &f64| tick(*v, yspan))
-            .light_line_style(WHITE.mix(0.0))
-            .label_style((FONT, 13))
-            .axis_desc_style((FONT, 14))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        for (k, &i) in nodes.iter().enumerate() {
-            let c = PALETTE[k % PALETTE.len()];
-            let mut first = true;
-            for p in pieces {
-                let a = chart
-                    .draw_series(LineSeries::new(
-                        [
-                            (p.alpha_from, p.lambda_n_from[i]),
-                            (p.alpha_to, p.lambda_n_to[i]),
-                        ],
-                        c.stroke_width(2),
-                    ))
-                    .map_err(|e| e.to_string())?;
-                if first {
-                    a.label(format!("node {}", i + 1)).legend(move |(x, y)| {
-                        PathElement::new(vec![(x - 8, y), (x + 12, y)], c.stroke_width(3))
-                    });
-                    first = false;
-                }
-            }
-            let own: Vec<MarkedPoint> = points.iter().filter(|m| m.node == i).cloned().collect();
-            draw_points(&mut chart, &own, |m| (m.alpha, m.lambda_n[i]), None)?;
-        }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK.mix(0.5))
-            .label_font((FONT, 13))
-            .draw()
-            .map_err(|e| e.to_string())?;
-        root.present().map_err(|e| e.to_string())
-    };
-    draw().map_err(plot_err(file))
+/// One figure written by [`run`]: the SVG, the PNG rendered from it beside it, and where
+/// its parts landed (SVG pixels).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Figure {
+    /// The SVG file.
+    pub svg: PathBuf,
+    /// The PNG beside it ([`write_png`]).
+    pub png: PathBuf,
+    /// Plot areas, data, legends.
+    pub layout: FigureLayout,
 }
 
-/// Marks transition points (black dots, numbered when `numbers`) and folds (red
-/// triangles).
-fn draw_points<'a, 'b: 'a>(
-    chart: &mut Chart<'a, 'b>,
-    points: &[MarkedPoint],
-    at: impl Fn(&MarkedPoint) -> (f64, f64),
-    numbers: Option<f64>,
-) -> std::result::Result<(), String> {
-    chart
-        .draw_series(
-            points
-                .iter()
-                .filter(|m| !m.fold)
-                .map(|m| Circle::new(at(m), 3, BLACK.filled())),
-        )
-        .map_err(|e| e.to_string())?;
-    let red = PALETTE[3];
-    let a = chart
-        .draw_series(
-            points
-                .iter()
-                .filter(|m| m.fold)
-                .map(|m| TriangleMarker::new(at(m), 7, red.filled())),
-        )
-        .map_err(|e| e.to_string())?;
-    if let Some(alpha_span) = numbers {
-        a.label("fold (α turns back)")
-            .legend(move |(x, y)| TriangleMarker::new((x, y), 7, red.filled()));
-        chart
-            .draw_series(
-                points
-                    .iter()
-                    .filter(|m| !m.fold)
-                    .take(0)
-                    .map(|m| Circle::new(at(m), 3, BLACK.filled())),
-            )
-            .map_err(|e| e.to_string())?
-            .label("transition point k")
-            .legend(|(x, y)| Circle::new((x, y), 3, BLACK.filled()));
-        // one label per cluster of transition points closer than 2% of the α range
-        let mut clusters: Vec<(usize, Vec<usize>)> = Vec::new();
-        for (k, m) in points.iter().enumerate() {
-            match clusters.last_mut() {
-                Some((first, ts)) if (points[*first].alpha - m.alpha).abs() < 0.04 * alpha_span => {
-                    if !ts.contains(&m.transition) {
-                        ts.push(m.transition);
-                    }
-                }
-                _ => clusters.push((k, vec![m.transition])),
-            }
-        }
-        for (first, ts) in clusters {
-            let text = if ts.len() > 3 {
-                format!("{}–{}", ts[0], ts[ts.len() - 1])
-            } else {
-                ts.iter()
-                    .map(|t| t.to_string())
-                    .collect::<Vec<_>>()
-                    .join(",")
-            };
-            chart
-                .draw_series([
-                    EmptyElement::at(at(&points[first])) + Text::new(text, (3, -16), (FONT, 12))
-                ])
-                .map_err(|e| e.to_string())?;
-        }
-    }
+/// Renders the PNG beside `svg` and records both files and the figure.
+fn add_figure(
+    svg: PathBuf,
+    layout: FigureLayout,
+    files: &mut Vec<PathBuf>,
+    figures: &mut Vec<Figure>,
+) -> Result<()> {
+    let png = write_png(&svg)?;
+    files.push(svg.clone());
+    files.push(png.clone());
+    figures.push(Figure { svg, png, layout });
     Ok(())
-}
-
-/// All solutions at one α (high-friction variant): λν and λt against the node index,
-/// one colour per solution, markers by class.
-pub fn plot_solutions(
-    list: &[ContactData],
-    labels: &[String],
-    title: &str,
-    file: &FsPath,
-) -> Result<()> {
-    let root = SVGBackend::new(file, (1200, 1300)).into_drawing_area();
-    let draw = || -> std::result::Result<(), String> {
-        root.fill(&WHITE).map_err(|e| e.to_string())?;
-        let root = root.titled(title, (FONT, 22)).map_err(|e| e.to_string())?;
-        let h = root.dim_in_pixel().1;
-        let (panels, strips) = root.split_vertically(h - 80);
-        let areas = panels.split_evenly((3, 1));
-        let (strip1, strip2) = strips.split_vertically(40);
-        let ser = |f: fn(&ContactData) -> &[f64]| -> Vec<(&[f64], &[Class], RGBColor)> {
-            list.iter()
-                .enumerate()
-                .map(|(k, d)| (f(d), d.classes.as_slice(), PALETTE[k % PALETTE.len()]))
-                .collect()
-        };
-        node_panel(
-            &areas[0],
-            "normal contact force λν",
-            "λν  [E·L]",
-            &ser(|d| &d.lambda_n),
-        )?;
-        node_panel(
-            &areas[1],
-            "tangential contact force λt",
-            "λt  [E·L]",
-            &ser(|d| &d.lambda_t),
-        )?;
-        node_panel(
-            &areas[2],
-            "normal displacement uν = −u_y (< 0: lifted off)",
-            "uν  [L]",
-            &ser(|d| &d.u_n),
-        )?;
-        let lines: Vec<Entry> = (0..list.len())
-            .map(|k| {
-                let l = labels
-                    .get(k)
-                    .cloned()
-                    .unwrap_or_else(|| format!("solution {}", k + 1));
-                Entry::Line(PALETTE[k % PALETTE.len()], l)
-            })
-            .collect();
-        legend_strip(&strip1, &lines)?;
-        legend_strip(&strip2, &class_entries())?;
-        root.present().map_err(|e| e.to_string())
-    };
-    draw().map_err(plot_err(file))
 }
 
 /// A traced path with its problem data, as the case study uses it.
@@ -1279,10 +482,11 @@ fn header(spec: &RectSpec, end: &EndReason, path: &Path) -> String {
 
 /// Runs the case study: see the module documentation. Writes below `opts.out`:
 /// `problem/` (the exchange format), `transitions.txt` (the table in the paper's words),
-/// `fig1_mesh.svg`, `fig2_snapshot.svg`, `fig3_profiles.svg`, `fig4_path.svg`,
-/// `path.json`, `path.csv` (vertices), `events.csv`, and for the high-friction variant
-/// `high-friction/` with its own `problem/`, `transitions.txt`, `path.svg`,
-/// `solutions.svg`, `path.json`, `path.csv`, `events.csv`.
+/// `fig1_mesh.svg`, `fig2_snapshot.svg`, `fig3_profiles.svg`, `fig4_path.svg` (each with
+/// its `.png`), `path.json`, `path.csv` (vertices), `events.csv`, and for the
+/// high-friction variant `high-friction/` with its own `problem/`, `transitions.txt`,
+/// `path.svg`, `path_folds.svg` (the zoom, [`fold_zoom`]), `solutions.svg` (with their
+/// PNGs), `path.json`, `path.csv`, `events.csv`.
 ///
 /// Errors: invalid spec, I/O, and the errors of the tracer (a path that ends by
 /// [`EndReason::Failed`] is reported in the table, not as an error).
@@ -1305,8 +509,10 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
     table.push_str(&seed_words(&rows));
     write(out.join("transitions.txt"), &table, &mut files)?;
 
-    plot_mesh(spec, &out.join("fig1_mesh.svg"))?;
-    files.push(out.join("fig1_mesh.svg"));
+    let mut figures = Vec::new();
+    let svg = out.join("fig1_mesh.svg");
+    let layout = plot_mesh(spec, &svg)?;
+    add_figure(svg, layout, &mut files, &mut figures)?;
 
     // Figure 2: the snapshot (trace further when it lies outside the window)
     let (lo, hi) = (
@@ -1341,16 +547,17 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
         } else {
             String::new()
         };
-        plot_snapshot(
+        let svg = out.join("fig2_snapshot.svg");
+        let layout = plot_snapshot(
             &d,
             &format!(
                 "Contact data at the {} contact nodes for α = {}{extra}",
                 spec.p(),
                 snap_alpha
             ),
-            &out.join("fig2_snapshot.svg"),
+            &svg,
         )?;
-        files.push(out.join("fig2_snapshot.svg"));
+        add_figure(svg, layout, &mut files, &mut figures)?;
     }
 
     // Figure 3: profiles by the cheap solution at any α
@@ -1360,15 +567,17 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
             profiles.push(ContactData::from_state(&sol.state, &case));
         }
     }
-    plot_profiles(
+    let svg = out.join("fig3_profiles.svg");
+    let layout = plot_profiles(
         &profiles,
-        "Profiles of the normal contact force λν (by the solution at any α from the traced path)",
-        &out.join("fig3_profiles.svg"),
+        "Profiles of the normal contact force λν (the solution at any α from the traced path)",
+        &svg,
     )?;
-    files.push(out.join("fig3_profiles.svg"));
+    add_figure(svg, layout, &mut files, &mut figures)?;
 
     // Figure 4: the path
-    plot_path(
+    let svg = out.join("fig4_path.svg");
+    let layout = plot_path(
         &piece_lines(&tr.path),
         &marked_points(&tr.path),
         &event_nodes(&tr.path),
@@ -1379,9 +588,9 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
             spec.friction,
             rows.last().map_or(0, |r| r.transition)
         ),
-        &out.join("fig4_path.svg"),
+        &svg,
     )?;
-    files.push(out.join("fig4_path.svg"));
+    add_figure(svg, layout, &mut files, &mut figures)?;
 
     let setup_s = prob_s + tr.setup_s;
     let js = path_json(&mut tr.path, &case, setup_s, tr.trace_s)?;
@@ -1395,7 +604,12 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
     write(out.join("events.csv"), &events_csv(&rows), &mut files)?;
 
     let fold = match &opts.fold_variant {
-        Some(v) => Some(run_fold_variant(v, &out.join("high-friction"), &mut files)?),
+        Some(v) => Some(run_fold_variant(
+            v,
+            &out.join("high-friction"),
+            &mut files,
+            &mut figures,
+        )?),
         None => None,
     };
 
@@ -1409,6 +623,7 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
         setup_s,
         trace_s: tr.trace_s,
         files,
+        figures,
         fold,
     })
 }
@@ -1449,10 +664,10 @@ pub fn clip_pieces(pieces: &[PieceLine], lo: f64, hi: f64) -> Vec<PieceLine> {
     out
 }
 
-/// An α inside a fold region where the traced path has the most solutions: the middle
-/// of the widest gap between consecutive distinct transition α's among the gaps covered
-/// by the largest number of traced (non-vertical) pieces. `None` when no α has two.
-fn fold_query(path: &Path) -> Option<f64> {
+/// The open α intervals between consecutive distinct transition α's and piece ends, each
+/// with the number of traced (non-vertical) pieces over it: the number of solutions the
+/// traced path has at any α inside.
+fn solution_counts(path: &Path) -> Vec<(f64, f64, usize)> {
     let mut alphas: Vec<f64> = path.events().iter().map(|e| e.alpha).collect();
     for r in path.pieces() {
         alphas.push(r.alpha_from);
@@ -1460,26 +675,62 @@ fn fold_query(path: &Path) -> Option<f64> {
     }
     alphas.sort_by(f64::total_cmp);
     alphas.dedup();
-    let mut best: Option<(usize, f64, f64)> = None;
-    for w in alphas.windows(2) {
-        let (a, width) = (0.5 * (w[0] + w[1]), w[1] - w[0]);
-        let count = path
-            .pieces()
-            .iter()
-            .filter(|r| r.alpha_from.min(r.alpha_to) < a && a < r.alpha_from.max(r.alpha_to))
-            .count();
-        let better = match best {
-            None => true,
-            Some((c, wd, _)) => count > c || (count == c && width > wd),
-        };
-        if better {
-            best = Some((count, width, a));
-        }
-    }
-    best.filter(|b| b.0 >= 2).map(|b| b.2)
+    alphas
+        .windows(2)
+        .map(|w| {
+            let a = 0.5 * (w[0] + w[1]);
+            let count = path
+                .pieces()
+                .iter()
+                .filter(|r| r.alpha_from.min(r.alpha_to) < a && a < r.alpha_from.max(r.alpha_to))
+                .count();
+            (w[0], w[1], count)
+        })
+        .collect()
 }
 
-fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> Result<FoldReport> {
+/// An α inside a fold region where the traced path has the most solutions: the middle
+/// of the widest of the intervals with the most solutions. `None` when no α has two.
+fn fold_query(path: &Path) -> Option<f64> {
+    let counts = solution_counts(path);
+    let most = counts.iter().map(|c| c.2).max().filter(|&m| m >= 2)?;
+    counts
+        .iter()
+        .filter(|c| c.2 == most)
+        .max_by(|x, y| (x.1 - x.0).total_cmp(&(y.1 - y.0)))
+        .map(|c| 0.5 * (c.0 + c.1))
+}
+
+/// The α window of the zoom on the folds (`path_folds.svg`): the α range where the
+/// traced path has the most solutions (at least two), widened to the folds that lie
+/// within 10 % of its width of it, plus a margin of 10 % of the result on each side.
+/// Folds far from that region (such as the first fold of the high-friction variant,
+/// where the corner starts to slip) are seen on the whole path's figure. `None` when no
+/// α has two solutions.
+pub fn fold_zoom(path: &Path) -> Option<(f64, f64)> {
+    let counts = solution_counts(path);
+    let most = counts.iter().map(|c| c.2).max().filter(|&m| m >= 2)?;
+    let best = counts.iter().filter(|c| c.2 == most);
+    let lo = best.clone().map(|c| c.0).reduce(f64::min)?;
+    let hi = best.map(|c| c.1).reduce(f64::max)?;
+    let near = 0.1 * (hi - lo);
+    let (mut a, mut b) = (lo, hi);
+    for e in path.events().iter().filter(|e| e.fold) {
+        if (lo - near..=hi + near).contains(&e.alpha) {
+            a = a.min(e.alpha);
+            b = b.max(e.alpha);
+        }
+    }
+    let margin = 0.1 * (b - a);
+    Some((a - margin, b + margin))
+}
+
+fn run_fold_variant(
+    v: &FoldVariant,
+    out: &FsPath,
+    files: &mut Vec<PathBuf>,
+    figures: &mut Vec<Figure>,
+) -> Result<FoldReport> {
     std::fs::create_dir_all(out).map_err(io_err(out))?;
     let spec = &v.spec;
     let case = generate(spec)?;
@@ -1540,7 +791,8 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
                 )
             })
             .collect();
-        plot_solutions(
+        let svg = out.join("solutions.svg");
+        let layout = plot_solutions(
             &data,
             &labels,
             &format!(
@@ -1549,14 +801,15 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
                 n_sol,
                 fmt_alpha(a)
             ),
-            &out.join("solutions.svg"),
+            &svg,
         )?;
-        files.push(out.join("solutions.svg"));
+        add_figure(svg, layout, files, figures)?;
     } else {
         table.push_str("no fold on this path\n");
     }
     write(out.join("transitions.txt"), &table, files)?;
-    plot_path(
+    let svg = out.join("path.svg");
+    let layout = plot_path(
         &piece_lines(&tr.path),
         &marked_points(&tr.path),
         &event_nodes(&tr.path),
@@ -1564,19 +817,12 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
             "High-friction variant (F = {}): the traced path, {} folds",
             spec.friction, folds
         ),
-        &out.join("path.svg"),
+        &svg,
     )?;
-    files.push(out.join("path.svg"));
-    // a zoom on the folds
-    let fold_alphas: Vec<f64> = rows.iter().filter(|r| r.fold).map(|r| r.alpha).collect();
-    if !fold_alphas.is_empty() {
-        let (lo, hi) = fold_alphas
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                (a.min(x), b.max(x))
-            });
-        let w = (hi - lo).max(1e-3 * (spec.alpha_end - spec.alpha_start).abs());
-        let (lo, hi) = (lo - 0.15 * w, hi + 0.15 * w);
+    add_figure(svg, layout, files, figures)?;
+    // a zoom on the region with the most solutions and its folds
+    let zoom = fold_zoom(&tr.path);
+    if let Some((lo, hi)) = zoom {
         let pieces = clip_pieces(&piece_lines(&tr.path), lo, hi);
         let points: Vec<MarkedPoint> = marked_points(&tr.path)
             .into_iter()
@@ -1589,17 +835,30 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
             }
         }
         nodes.sort_unstable();
-        plot_path(
+        let inside: Vec<String> = points
+            .iter()
+            .filter(|m| m.fold)
+            .map(|m| m.transition.to_string())
+            .collect();
+        let most = solution_counts(&tr.path)
+            .iter()
+            .map(|c| c.2)
+            .max()
+            .unwrap_or(0);
+        let svg = out.join("path_folds.svg");
+        let layout = plot_path_window(
             &pieces,
             &points,
             &nodes,
+            Some((lo, hi)),
             &format!(
-                "High-friction variant (F = {}): zoom on the folds, α ∈ [{:.4}, {:.4}]",
-                spec.friction, lo, hi
+                "F = {}: zoom on the folds {} (the α range with {most} solutions)",
+                spec.friction,
+                inside.join(", "),
             ),
-            &out.join("path_folds.svg"),
+            &svg,
         )?;
-        files.push(out.join("path_folds.svg"));
+        add_figure(svg, layout, files, figures)?;
     }
     let js = path_json(&mut tr.path, &case, tr.setup_s, tr.trace_s)?;
     write(
@@ -1617,6 +876,7 @@ fn run_fold_variant(v: &FoldVariant, out: &FsPath, files: &mut Vec<PathBuf>) -> 
         folds,
         alpha_query,
         solutions: n_sol,
+        zoom,
     })
 }
 
@@ -1659,89 +919,5 @@ mod tests {
             seed_words(&rows),
             "at transition point 6, α = 0.28019791259766, contact node 13 changes from no contact to contact, slip (+x)\n"
         );
-    }
-
-    fn synthetic(p: usize, alpha: f64) -> ContactData {
-        let classes: Vec<Class> = (0..p).map(|i| Class::ALL[i % 4]).collect();
-        ContactData {
-            alpha,
-            lambda_n: (0..p)
-                .map(|i| {
-                    if i % 4 == 0 {
-                        0.0
-                    } else {
-                        -(i as f64) * 0.01 * (1.0 + alpha)
-                    }
-                })
-                .collect(),
-            lambda_t: (0..p).map(|i| 0.003 * i as f64 - 0.02).collect(),
-            u_n: (0..p)
-                .map(|i| if i % 4 == 0 { -1e-3 * i as f64 } else { 0.0 })
-                .collect(),
-            u_t: (0..p).map(|i| 1e-4 * (i as f64).sin()).collect(),
-            classes,
-        }
-    }
-
-    #[test]
-    fn figures_draw_on_synthetic_data() {
-        let dir = std::env::temp_dir().join(format!("fricont-fig-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let spec = RectSpec::default();
-        plot_mesh(&spec, &dir.join("mesh.svg")).unwrap();
-        let d = synthetic(30, 3.6);
-        plot_snapshot(&d, "snapshot", &dir.join("snap.svg")).unwrap();
-        let list: Vec<ContactData> = [-0.5, 0.0, 0.5, 1.0, 1.5]
-            .iter()
-            .map(|&a| synthetic(30, a))
-            .collect();
-        plot_profiles(&list, "profiles", &dir.join("prof.svg")).unwrap();
-        plot_solutions(&list[..3], &[], "solutions", &dir.join("sols.svg")).unwrap();
-        let pieces: Vec<PieceLine> = (0..4)
-            .map(|k| {
-                let a = [0.0, 1.0, 0.5, 1.5, 2.0][k];
-                let b = [0.0, 1.0, 0.5, 1.5, 2.0][k + 1];
-                PieceLine {
-                    alpha_from: a,
-                    alpha_to: b,
-                    lambda_n_from: vec![-a; 30],
-                    lambda_n_to: vec![-b; 30],
-                    lambda_t_from: vec![0.1 * a; 30],
-                    lambda_t_to: vec![0.1 * b; 30],
-                }
-            })
-            .collect();
-        let pts: Vec<MarkedPoint> = (1..4)
-            .map(|k| MarkedPoint {
-                transition: k,
-                alpha: pieces[k].alpha_from,
-                lambda_n: pieces[k].lambda_n_from.clone(),
-                lambda_t: pieces[k].lambda_t_from.clone(),
-                fold: k == 1,
-                node: k,
-            })
-            .collect();
-        plot_path(&pieces, &pts, &[0, 5, 12], "path", &dir.join("path.svg")).unwrap();
-        for f in ["mesh", "snap", "prof", "sols", "path"] {
-            let s = std::fs::read_to_string(dir.join(format!("{f}.svg"))).unwrap();
-            assert!(s.starts_with("<svg") && s.contains("</svg>"), "{f}");
-        }
-        let s = std::fs::read_to_string(dir.join("snap.svg")).unwrap();
-        for label in [
-            "contact node i",
-            "λν  [E·L]",
-            "uν  [L]",
-            "no contact",
-            "contact, stick",
-        ] {
-            assert!(s.contains(label), "snapshot lacks {label}");
-        }
-        let s = std::fs::read_to_string(dir.join("path.svg")).unwrap();
-        assert!(s.contains("fold (α turns back)") && s.contains("load parameter α"));
-        if std::env::var_os("FRICONT_KEEP_FIGS").is_none() {
-            std::fs::remove_dir_all(&dir).unwrap();
-        } else {
-            eprintln!("figures kept in {}", dir.display());
-        }
     }
 }

@@ -8,16 +8,20 @@
 //! * the profiles of Figure 3 ("the cheap solution at any α") agree with the fixed-α
 //!   solver started afresh at those α (a different algorithm);
 //! * the high-friction variant has a fold, and the several solutions it reports at one α
-//!   are distinct genuine solutions.
+//!   are distinct genuine solutions;
+//! * the figures are fit for print (text size at 16 cm, a PNG beside each SVG, legends
+//!   off the data and only for what is drawn, a zoom that contains what it zooms on);
+//! * the numbers quoted in `docs/case-study.md` and the README are the computed ones.
 
 use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
 
 use fricont::path::{Path, PathOptions, State};
 use fricont::{Class, EndReason};
-use fricont_cli::casestudy::{CaseStudyOptions, CaseStudyReport, run};
+use fricont_cli::casestudy::{CaseStudyOptions, CaseStudyReport, PxRect, run};
 use fricont_exchange::generator::{RectSpec, generate};
 use fricont_exchange::io::CaseData;
+use fricont_exchange::report::fmt_alpha;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("fricont-{name}-{}", std::process::id()));
@@ -462,4 +466,421 @@ fn case_study_transitions_do_not_depend_on_r() {
             }
         }
     }
+}
+
+/// 8 pt when printed 16 cm wide, as a fraction of the figure's width (from the print
+/// rule itself, not from the code's constants).
+const MIN_FONT_FRACTION: f64 = 8.0 / 72.0 / (16.0 / 2.54);
+/// 16 cm at 300 dpi.
+const PNG_WIDTH: u32 = 1890;
+
+fn svg_files(dir: &FsPath, out: &mut Vec<PathBuf>) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_dir() {
+            svg_files(&p, out);
+        } else if p.extension().is_some_and(|x| x == "svg") {
+            out.push(p);
+        }
+    }
+}
+
+/// The value of attribute `name` in an XML start tag.
+fn attr(tag: &str, name: &str) -> Option<String> {
+    let key = format!(" {name}=\"");
+    let start = tag.find(&key)? + key.len();
+    Some(tag[start..].split('"').next()?.to_string())
+}
+
+/// The start tags `<name …>` of an SVG text.
+fn tags<'a>(svg: &'a str, name: &str) -> Vec<&'a str> {
+    let open = format!("<{name} ");
+    svg.match_indices(&open)
+        .map(|(i, _)| &svg[i..i + svg[i..].find('>').unwrap()])
+        .collect()
+}
+
+/// All text of the SVG's `<text>` elements, in order, joined by spaces.
+fn svg_text(svg: &str) -> String {
+    svg.split("<text ")
+        .skip(1)
+        .map(|t| t[t.find('>').unwrap() + 1..t.find("</text>").unwrap()].trim())
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+#[test]
+fn figures_are_fit_for_print() {
+    let (out, report) = run_case_study("cs-print");
+    let mut svgs = Vec::new();
+    svg_files(&out, &mut svgs);
+    svgs.sort();
+    let mut reported: Vec<PathBuf> = report.figures.iter().map(|f| f.svg.clone()).collect();
+    reported.sort();
+    assert_eq!(svgs, reported, "every SVG written is a reported figure");
+    assert_eq!(
+        svgs.len(),
+        7,
+        "4 figures and 3 of the high-friction variant"
+    );
+    for svg in &svgs {
+        let name = svg.strip_prefix(&out).unwrap().display().to_string();
+        let text = std::fs::read_to_string(svg).unwrap();
+        let root = tags(&text, "svg")[0];
+        let w: f64 = attr(root, "width").unwrap().parse().unwrap();
+        let h: f64 = attr(root, "height").unwrap().parse().unwrap();
+        // every text at least 8 pt at 16 cm
+        let texts = tags(&text, "text");
+        assert!(texts.len() > 5, "{name}: {} texts", texts.len());
+        for t in &texts {
+            let size: f64 = attr(t, "font-size")
+                .unwrap_or_else(|| panic!("{name}: a text without font-size: {t}"))
+                .parse()
+                .unwrap();
+            assert!(
+                size >= MIN_FONT_FRACTION * w,
+                "{name}: font-size {size} px < 8 pt at 16 cm ({} px of {w})",
+                MIN_FONT_FRACTION * w
+            );
+        }
+        // the PNG beside it: 16 cm at 300 dpi, the SVG's proportions, text drawn
+        let png = svg.with_extension("png");
+        let dec = png::Decoder::new(std::io::BufReader::new(
+            std::fs::File::open(&png).unwrap_or_else(|e| panic!("{name}: no PNG beside it: {e}")),
+        ));
+        let mut reader = dec.read_info().unwrap();
+        let info = reader.info().clone();
+        assert_eq!(info.width, PNG_WIDTH, "{name}");
+        let expect_h = h * f64::from(PNG_WIDTH) / w;
+        assert!(
+            (f64::from(info.height) - expect_h).abs() <= 1.0,
+            "{name}: PNG height {} for {expect_h}",
+            info.height
+        );
+        let dims = info.pixel_dims.expect("pHYs");
+        assert_eq!(dims.unit, png::Unit::Meter);
+        assert_eq!((dims.xppu, dims.yppu), (11811, 11811), "{name}: 300 dpi");
+        assert_eq!(info.color_type, png::ColorType::Rgb, "{name}");
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut buf).unwrap();
+        // the title (only text) occupies the top 3.5 % of the width: it must be drawn
+        let band = (0.035 * f64::from(PNG_WIDTH)) as usize;
+        let row = 3 * PNG_WIDTH as usize;
+        let dark = buf[..band * row]
+            .chunks(3)
+            .filter(|p| p.iter().all(|&c| c < 100))
+            .count();
+        assert!(
+            dark > 500,
+            "{name}: the title is not drawn ({dark} dark pixels)"
+        );
+        let white = buf
+            .chunks(3)
+            .filter(|p| p.iter().all(|&c| c == 255))
+            .count();
+        assert!(white > buf.len() / 3 / 2, "{name}: background not white");
+    }
+    for fig in &report.figures {
+        let name = fig.svg.strip_prefix(&out).unwrap().display().to_string();
+        let l = &fig.layout;
+        let text = std::fs::read_to_string(&fig.svg).unwrap();
+        let root = tags(&text, "svg")[0];
+        assert_eq!(attr(root, "width").unwrap(), l.width.to_string(), "{name}");
+        assert_eq!(
+            attr(root, "height").unwrap(),
+            l.height.to_string(),
+            "{name}"
+        );
+        assert!(!l.plots.is_empty() && !l.data.is_empty() && !l.legends.is_empty());
+        let canvas = PxRect {
+            x0: 0.0,
+            y0: 0.0,
+            x1: f64::from(l.width),
+            y1: f64::from(l.height),
+        };
+        for (k, g) in l.legends.iter().enumerate() {
+            assert!(canvas.contains(g), "{name}: legend {g:?} off the canvas");
+            for p in &l.plots {
+                assert!(!g.intersects(p), "{name}: legend {g:?} over the plot {p:?}");
+            }
+            for d in &l.data {
+                assert!(!g.intersects(d), "{name}: legend {g:?} over data at {d:?}");
+            }
+            for o in &l.legends[k + 1..] {
+                assert!(!g.intersects(o), "{name}: legends {g:?} and {o:?} overlap");
+            }
+        }
+        for d in &l.data {
+            assert!(
+                l.plots.iter().any(|p| p.contains(d)),
+                "{name}: data at {d:?} outside every plot area"
+            );
+        }
+        for e in &l.legend_entries {
+            assert!(
+                l.drawn_count(e) > 0,
+                "{name}: legend entry {e:?} for nothing drawn"
+            );
+            assert!(
+                text.contains(e.as_str()),
+                "{name}: entry {e:?} not in the SVG"
+            );
+        }
+        for (label, n) in &l.drawn {
+            assert!(
+                *n == 0 || l.legend_entries.contains(label),
+                "{name}: {label:?} drawn but not in the legend"
+            );
+        }
+    }
+    let fig = |f: &str| {
+        report
+            .figures
+            .iter()
+            .find(|x| x.svg == out.join(f))
+            .unwrap_or_else(|| panic!("{f}"))
+    };
+    // the main path has no fold: no fold entry; the variant's has
+    assert!(!report.transitions.iter().any(|t| t.fold));
+    let fold_entry = |f: &str| {
+        fig(f)
+            .layout
+            .legend_entries
+            .iter()
+            .any(|e| e.contains("fold"))
+    };
+    assert!(
+        !fold_entry("fig4_path.svg"),
+        "a fold entry where there is no fold"
+    );
+    assert!(fold_entry("high-friction/path.svg"));
+    assert!(fold_entry("high-friction/path_folds.svg"));
+
+    // Figure 2: its class entries are the classes of a fresh solve at α = 3.6, and every
+    // marker (the legend's too) has the data's colour
+    let spec = RectSpec::default();
+    let case = generate(&spec).unwrap();
+    let problem = Arc::new(case.problem(None).unwrap());
+    let mut fresh = Path::new(
+        problem,
+        case.load().unwrap(),
+        PathOptions::window(3.6, -0.5),
+    )
+    .unwrap();
+    fresh.start(3.6, None).unwrap();
+    let classes = &fresh.start_state().unwrap().classes;
+    let label = |c: Class| match c {
+        Class::Open => "no contact",
+        Class::Stick => "contact, stick",
+        Class::SlipPlus => "contact, slip +x",
+        Class::SlipMinus => "contact, slip −x",
+    };
+    let mut expected: Vec<&str> = Class::ALL
+        .iter()
+        .filter(|c| classes.contains(c))
+        .map(|&c| label(c))
+        .collect();
+    expected.sort_unstable();
+    let mut entries: Vec<&str> = fig("fig2_snapshot.svg")
+        .layout
+        .legend_entries
+        .iter()
+        .map(String::as_str)
+        .collect();
+    entries.sort_unstable();
+    assert_eq!(entries, expected, "Figure 2's legend");
+    let svg2 = std::fs::read_to_string(out.join("fig2_snapshot.svg")).unwrap();
+    let mut markers = 0;
+    for name in ["circle", "polygon", "rect"] {
+        for t in tags(&svg2, name) {
+            let colours: Vec<String> = ["fill", "stroke"]
+                .iter()
+                .filter_map(|a| attr(t, a))
+                .filter(|c| c != "none")
+                .collect();
+            if colours == ["#FFFFFF"] {
+                continue; // the background
+            }
+            markers += 1;
+            assert!(
+                colours.iter().all(|c| c == "#1F77B4"),
+                "Figure 2: a marker in {colours:?}: {t}"
+            );
+        }
+    }
+    // 4 panels × 30 nodes, and one legend marker per entry
+    assert_eq!(markers, 4 * 30 + expected.len());
+
+    // the zoom on the folds contains every α with the most solutions and the folds
+    // next to them, away from its edges, and names exactly the folds it contains
+    let fr = report.fold.as_ref().unwrap();
+    let (lo, hi) = fr.zoom.expect("a zoom");
+    let hf = RectSpec::high_friction();
+    assert!(
+        hi - lo < 0.1 * (hf.alpha_end - hf.alpha_start),
+        "not a zoom: [{lo}, {hi}]"
+    );
+    assert_eq!(
+        fig("high-friction/path_folds.svg").layout.alpha_axis,
+        Some((lo, hi)),
+        "the zoom's α axis"
+    );
+    let (_, mut path) = trace_dir(&out.join("high-friction").join("problem"));
+    let mut alphas: Vec<f64> = path.events().iter().map(|e| e.alpha).collect();
+    alphas.extend([hf.alpha_start, hf.alpha_end]);
+    alphas.sort_by(f64::total_cmp);
+    alphas.dedup();
+    let counted: Vec<(f64, usize)> = alphas
+        .windows(2)
+        .map(|w| 0.5 * (w[0] + w[1]))
+        .map(|a| (a, path.solutions_at(a).unwrap().len()))
+        .collect();
+    let most = counted.iter().map(|c| c.1).max().unwrap();
+    assert!(most >= 3, "{most}");
+    for &(a, c) in &counted {
+        if c == most {
+            assert!(
+                (lo..=hi).contains(&a),
+                "α = {a} has {c} solutions, outside the zoom"
+            );
+        }
+    }
+    // and it is a zoom on that range: the range fills most of it
+    let (mut ra, mut rb) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (w, c) in alphas.windows(2).zip(&counted) {
+        if c.1 == most {
+            ra = ra.min(w[0]);
+            rb = rb.max(w[1]);
+        }
+    }
+    assert!(
+        rb - ra >= 0.5 * (hi - lo),
+        "the range with {most} solutions, [{ra}, {rb}], is lost in the zoom [{lo}, {hi}]"
+    );
+    assert!((lo..=hi).contains(&fr.alpha_query.unwrap()));
+    let inside: Vec<usize> = fr
+        .transitions
+        .iter()
+        .filter(|t| t.fold && (lo..=hi).contains(&t.alpha))
+        .map(|t| t.transition)
+        .collect();
+    assert!(inside.len() >= 2, "{inside:?}");
+    for t in fr.transitions.iter().filter(|t| t.fold) {
+        if (lo..=hi).contains(&t.alpha) {
+            let edge = (t.alpha - lo).min(hi - t.alpha);
+            assert!(
+                edge >= 0.05 * (hi - lo),
+                "fold {} on the zoom's edge",
+                t.transition
+            );
+        }
+    }
+    let title =
+        svg_text(&std::fs::read_to_string(out.join("high-friction/path_folds.svg")).unwrap());
+    let named: Vec<usize> = title
+        .split("folds ")
+        .nth(1)
+        .unwrap()
+        .split(|c: char| !c.is_ascii_digit() && c != ',' && c != ' ')
+        .next()
+        .unwrap()
+        .split(',')
+        .filter_map(|s| s.trim().parse().ok())
+        .collect();
+    assert_eq!(named, inside, "the zoom's title: {title}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// Collapses every run of whitespace to one space.
+fn squash(s: &str) -> String {
+    s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[test]
+fn documented_numbers_are_the_computed_ones() {
+    let (out, report) = run_case_study("cs-docs");
+    let repo = FsPath::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let doc = std::fs::read_to_string(repo.join("docs/case-study.md")).unwrap();
+    let readme = std::fs::read_to_string(repo.join("README.md")).unwrap();
+    // the table of docs/case-study.md is the one printed, line for line
+    let table = |s: &str| -> Vec<String> {
+        s.lines()
+            .map(str::trim)
+            .filter(|l| l.starts_with("at transition point "))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(
+        table(&doc),
+        table(&report.table),
+        "docs/case-study.md's table is not the output of `fricont case-study`:\n{}",
+        table(&report.table).join("\n")
+    );
+    // every other number quoted, to its printed digits
+    let main = |k: usize| {
+        let t = &report.transitions[k - 1];
+        assert_eq!(t.transition, k);
+        t.alpha
+    };
+    let fr = report.fold.as_ref().unwrap();
+    let hf = |k: usize| {
+        let t = fr.transitions.iter().find(|t| t.transition == k).unwrap();
+        assert!(t.fold, "transition {k} is quoted as a fold");
+        t.alpha
+    };
+    let query = fr.alpha_query.unwrap();
+    let folds = fr.transitions.iter().filter(|t| t.fold).count();
+    let quotes_doc = [
+        format!("({:.3}, {:.3}, {:.3} against", main(6), main(7), main(8)),
+        format!("transition point 29 (α = {})", fmt_alpha(hf(29))),
+        format!("α = {} (transition 30, a second fold)", fmt_alpha(hf(30))),
+        format!("until {} (transition 38)", fmt_alpha(hf(38))),
+        format!("until {} (transition 46)", fmt_alpha(hf(46))),
+        format!("{folds} folds in all"),
+        format!("On ({:.4}, {:.4})", hf(46), hf(38)),
+        format!("(α = {})", fmt_alpha(query)),
+        format!("all **{} solutions**", fr.solutions),
+    ];
+    let quotes_readme = [
+        format!(
+            "at α = {:.3}, {:.3}, {:.3} (the paper",
+            main(6),
+            main(7),
+            main(8)
+        ),
+        format!(
+            "{folds} folds, with all {} solutions at α = {:.3} drawn",
+            fr.solutions, query
+        ),
+        format!("has {} transition points", report.transitions.len()),
+    ];
+    let (sdoc, sreadme) = (squash(&doc), squash(&readme));
+    for q in &quotes_doc {
+        assert!(
+            sdoc.contains(&squash(q)),
+            "docs/case-study.md should say {q:?}"
+        );
+    }
+    for q in &quotes_readme {
+        assert!(sreadme.contains(&squash(q)), "README.md should say {q:?}");
+    }
+    // no long number escapes these checks (the paper's three are its own)
+    let papers = ["0.28019791259766", "0.42934036865234", "0.60403706054688"];
+    let table_text = table(&report.table).join("\n");
+    for (file, text, quotes) in [
+        ("docs/case-study.md", &sdoc, &quotes_doc[..]),
+        ("README.md", &sreadme, &quotes_readme[..]),
+    ] {
+        for word in text.split(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-')) {
+            let digits = word.chars().filter(char::is_ascii_digit).count();
+            if digits < 7 || word.parse::<f64>().is_err() {
+                continue;
+            }
+            let covered = papers.contains(&word)
+                || table_text.contains(word)
+                || quotes.iter().any(|q| q.contains(word));
+            assert!(covered, "{file}: {word} is checked against nothing");
+        }
+    }
+    std::fs::remove_dir_all(&out).unwrap();
 }
