@@ -484,6 +484,10 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// entry (`|A||u|` rather than `A u`), as in a normwise backward error: it is what
 /// rounding errors are proportional to, and it does not depend on the units of u or f.
 ///
+/// B, λ, g and r are those of the equilibrated rows ([`Problem::b`]); an A of extreme
+/// size enters as it was factorised (H1 times `2^(k/2)`, k = [`Problem::a_scale_log2`],
+/// 0 for ordinary data), so that H1 is measured in the units of the forces of H2, H3.
+///
 /// Without A (a host's solve, or condensed input) H1 is not evaluated. With a host's
 /// solve `B u` comes from its u; for condensed input (u empty, `f` the condensed load q)
 /// `B u = q + W λ`, with `|q| + |W||λ|` as its terms' magnitude.
@@ -517,22 +521,28 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
         }
     }
     if let Some(a) = problem.a() {
+        // H1 of the problem as factorised, 2^(k/2) (A u − f − Bᵀ λ) with A scaled by 2^k
+        // (k = a_scale_log2, 0 for ordinary data): every product below is between
+        // numbers of the range that was factorised (exact scalings by powers of two).
+        let hs = crate::problem::mul_pow2(1.0, problem.a_scale_log2() / 2);
+        let u_s: Vec<f64> = u.iter().map(|v| v / hs).collect();
         let mut btl = vec![0.0; n];
         let mut btl_abs = vec![0.0; n];
         for (i, &l) in lam.iter().enumerate() {
             for (j, v) in problem.b().row(i) {
-                btl[j] += v * l;
-                btl_abs[j] += (v * l).abs();
+                btl[j] += hs * v * l;
+                btl_abs[j] += (hs * v * l).abs();
             }
         }
         for i in 0..n {
             let (mut au, mut au_abs) = (0.0, 0.0);
             for (j, v) in a.row(i) {
-                au += v * u[j];
-                au_abs += (v * u[j]).abs();
+                au += v * u_s[j];
+                au_abs += (v * u_s[j]).abs();
             }
-            h = h.max((au - f[i] - btl[i]).abs());
-            scale = scale.max(au_abs).max(f[i].abs()).max(btl_abs[i]);
+            let fi = hs * f[i];
+            h = h.max((au - fi - btl[i]).abs());
+            scale = scale.max(au_abs).max(fi.abs()).max(btl_abs[i]);
         }
     }
     for i in 0..p {
@@ -549,7 +559,13 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
             .max(r * bu_abs[p + i])
             .max(r * g.abs());
     }
-    if h.is_nan() { f64::INFINITY } else { h / scale }
+    // (f64::max drops NaN: a NaN or infinite term shows in the sums, h or the scale)
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if h.is_finite() && scale.is_finite() && finite(u) && finite(lam) && finite(f) {
+        h / scale
+    } else {
+        f64::INFINITY
+    }
 }
 
 #[cfg(test)]
