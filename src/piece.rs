@@ -493,6 +493,30 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// `B u = q + W λ`, with `|q| + |W||λ|` as its terms' magnitude.
 pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
     let (n, p, r) = (problem.n(), problem.p(), problem.r());
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !(finite(u) && finite(lam) && finite(f)) {
+        return f64::INFINITY;
+    }
+    // Terms near the end of the range of doubles (a load of 1e308, u of 1e308) would
+    // overflow in the sums below: u, f, λ and g are multiplied by a power of two σ first,
+    // which does not change H / scale (H is homogeneous of degree one in them).
+    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let big = inf(u)
+        .max(inf(f))
+        .max(inf(lam))
+        .max(inf(problem.gap_equilibrated()));
+    let sigma_log2 = if big > 0.0 && !(2f64.powi(-500)..=2f64.powi(500)).contains(&big) {
+        -(big.log2().ceil() as i32)
+    } else {
+        0
+    };
+    let sigma = |v: &[f64]| -> Vec<f64> {
+        v.iter()
+            .map(|&x| crate::problem::mul_pow2(x, sigma_log2))
+            .collect()
+    };
+    let (u, lam, f) = (&sigma(u)[..], &sigma(lam)[..], &sigma(f)[..]);
+    let gap = sigma(problem.gap_equilibrated());
     let mut h = 0.0f64;
     let mut scale = 1e-300f64;
     let mut bu = vec![0.0; 2 * p];
@@ -505,6 +529,7 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
             .condense(f)
             .unwrap_or_else(|_| vec![f64::NAN; 2 * p]);
         for i in 0..2 * p {
+            // (condense is linear: q of the scaled load)
             bu[i] = q[i];
             bu_abs[i] = q[i].abs();
             for (j, &l) in lam.iter().enumerate() {
@@ -546,7 +571,7 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
         }
     }
     for i in 0..p {
-        let g = problem.gap_equilibrated()[i];
+        let g = gap[i];
         let (ln, lt) = (lam[i], lam[p + i]);
         let h2 = ln - (ln - r * (bu[i] - g)).min(0.0);
         let b = (-problem.friction()[i] * ln).max(0.0);
@@ -559,9 +584,8 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
             .max(r * bu_abs[p + i])
             .max(r * g.abs());
     }
-    // (f64::max drops NaN: a NaN or infinite term shows in the sums, h or the scale)
-    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    if h.is_finite() && scale.is_finite() && finite(u) && finite(lam) && finite(f) {
+    // (f64::max drops NaN: a NaN term shows in the sums, h or the scale)
+    if h.is_finite() && scale.is_finite() && finite(&bu) {
         h / scale
     } else {
         f64::INFINITY

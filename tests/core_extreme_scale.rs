@@ -368,3 +368,46 @@ fn condensed_w_near_the_largest_double() {
         }
     }
 }
+
+/// Loads near the largest double (entries up to 1e308 on ordinary A): the residual of a
+/// reported state is computed without overflow (its terms are scaled by a power of two
+/// first), so a correct state is not reported with an infinite residual. (Within a few
+/// percent of f64::MAX, 1.7e308, the tracer itself fails with a clean error.)
+#[test]
+fn residual_of_loads_near_the_largest_double() {
+    for seed in 0..20 {
+        let case = random_case(seed);
+        let fmax = case.data.f0.amax().max(case.data.f1.amax()) * (1.0 + case.a0.abs());
+        for target in [1e306, 1e308] {
+            let c = target / fmax;
+            let load = Load::affine(
+                case.data.f0.iter().map(|v| v * c).collect(),
+                case.data.f1.iter().map(|v| v * c).collect(),
+            )
+            .unwrap();
+            let mut data = case.data.clone();
+            data.gap.iter_mut().for_each(|g| *g *= c);
+            let mut path = Path::new(
+                Arc::new(data.problem()),
+                load,
+                PathOptions::window(case.a0, case.a1),
+            )
+            .unwrap();
+            match path.start(case.a0, None) {
+                Ok(()) => {
+                    let s = path.start_state().unwrap();
+                    // (> 0: an overflowed scale used to give h / inf = 0; the rounding
+                    // of A u − f is never exactly zero on these random data)
+                    assert!(
+                        s.residual > 0.0 && s.residual <= 1e-12,
+                        "seed {seed}, load {target:e}: residual {:e}",
+                        s.residual
+                    );
+                }
+                // u itself beyond the range of a double: an error, never a wrong state
+                Err(Error::Numerical(m)) => assert!(m.contains("overflows"), "{m}"),
+                Err(e) => panic!("seed {seed}, load {target:e}: {e}"),
+            }
+        }
+    }
+}
