@@ -627,10 +627,12 @@ const A_BAND: i32 = 64;
 /// would otherwise give a W with subnormal entries (and a trace that overflows), and one
 /// with subnormal entries (1e-310) a meaningless factorisation.
 ///
-/// The problem `(A, f, λ, u)` is the same as `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u)`
-/// with `B` and `g` unchanged; fricont traces the latter with its rows of B divided by
-/// `2^(k/2)` on top of the node's own scale, so W, q and the forces the path works with
-/// stay in the range of ordinary numbers, and reports the former. The node scales
+/// The problem `(A, f, λ, u, g)` is the same as
+/// `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u, 2^(-k/2) g)` with `B` unchanged; fricont
+/// factorises the latter, and traces with the rows of B divided by `2^(k/2)` on top of
+/// the node's own scale (forces `2^(k/2) λ` then pair with the caller's u and g), so W,
+/// q and the forces the path works with stay in the range of ordinary numbers, and
+/// reports the former. The node scales
 /// `unit_scale[i] · 2^(k/2)` must stay within `[2^-1000, 2^1000]`: k is moved toward 0
 /// as far as they require (only for rows of N, T of absurd size).
 fn stiffness_exponent(max_abs: f64, unit_scale: &[f64]) -> i32 {
@@ -1031,9 +1033,9 @@ impl Problem {
     /// entry lies outside `[2^-64, 2^64]`, then the k that brings it into `[1, 4)`).
     /// Extreme but valid scales (A × 4e307, subnormal entries) are factorised as
     /// ordinary numbers this way; results are reported in the caller's units. The problem
-    /// `(A, f, λ, u)` is traced as `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u)`: `2^(k/2)`
-    /// is part of [`Problem::node_scale`], and the residual of a state is that of the
-    /// scaled equations. 0 for a host's solve and condensed data.
+    /// `(A, f, λ, u, g)` is factorised as `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u,
+    /// 2^(-k/2) g)`: `2^(k/2)` is part of [`Problem::node_scale`], and the residual of a
+    /// state is that of the scaled equations. 0 for a host's solve and condensed data.
     pub fn a_scale_log2(&self) -> i32 {
         self.a_scale_log2
     }
