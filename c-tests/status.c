@@ -826,6 +826,12 @@ static void test_host_input(void) {
     EXPECT(fricont_problem_new_solve(1, diag_solve, &sd, NULL, 1, &nm, &tm, &p), FRICONT_ERR_LENGTH, "N is 1x2");
     EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 0, &nm, &tm, &p), FRICONT_ERR_LENGTH, "max_block");
     EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 1, NULL, &tm, &p), FRICONT_ERR_NULL, "N");
+    /* 2p > n: two contact nodes on two dofs, refused at once (the header's LENGTH) */
+    int64_t rp22[] = {0, 1, 2}, ci22[] = {0, 1};
+    double v22[] = {1.0, 1.0};
+    fricont_csr n22 = mk(2, 2, 2, rp22, ci22, v22, 0);
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 1, &n22, &n22, &p), FRICONT_ERR_LENGTH,
+           "2p = 4 exceeds n = 2");
     /* fatal, recoverable twice, recoverable once (then fine) */
     int codes[3] = {-3, 5, 5}, times[3] = {1, 2, 1};
     fricont_status wants[3] = {FRICONT_ERR_SOLVE_CALLBACK, FRICONT_ERR_SOLVE_CALLBACK, FRICONT_OK};
