@@ -112,6 +112,40 @@ static void test_csr_errors(void) {
     double v_big[] = {1e308, 1e308, 1.0};
     b = mk(2, 2, 3, rp_dup, ci_dup, v_big, 0);
     EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_NONFINITE, "sum to inf");
+    /* extreme int64 values: errors, never an overflow in the library's index arithmetic
+     * (checked in debug builds too by tests/core_errors.rs) */
+    int64_t rp_min[] = {0, INT64_MIN, 2}, rp_max[] = {0, 1, INT64_MAX};
+    b = a;
+    b.row_ptr = rp_min;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "decreases");
+    b.row_ptr = rp_max;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "outside");
+    int64_t ci_max[] = {0, INT64_MAX}, ci_min[] = {INT64_MIN, 1};
+    b = a;
+    b.col_idx = ci_max;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "column index");
+    b.col_idx = ci_min;
+    b.index_base = 1;
+    int64_t rp_one[] = {1, 2, 3};
+    b.row_ptr = rp_one;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "column index");
+    int64_t rp_first_max[] = {INT64_MAX, INT64_MAX, INT64_MAX};
+    b = a;
+    b.row_ptr = rp_first_max;
+    b.index_base = 1;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "row_ptr[0]");
+    b = a;
+    b.index_base = INT64_MIN;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_CSR, "index_base");
+    b = a;
+    b.nrows = INT64_MAX;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_LENGTH, "not a valid length");
+    b = a;
+    b.nnz = INT64_MAX;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_LENGTH, "not a valid length");
+    b = a;
+    b.ncols = INT64_MIN;
+    EXPECT(fricont_problem_new(&b, 0, &n, &t, &p), FRICONT_ERR_LENGTH, "not a valid length");
     /* index base 2 */
     b = a;
     b.index_base = 2;
@@ -278,7 +312,10 @@ static void test_path_construction(void) {
     CHECK(path == NULL, "out cleared");
     EXPECT(fricont_path_new_affine(p, f0, f1, 2, NULL), FRICONT_ERR_NULL, "out");
     EXPECT(fricont_path_new_affine(p, NULL, f1, 2, &path), FRICONT_ERR_NULL, "f0");
-    EXPECT(fricont_path_new_affine(p, f0, f1, 3, &path), FRICONT_ERR_LENGTH, "n = 2");
+    /* (arrays of 3: the library may read n entries before it compares n with the
+     * problem's; AddressSanitizer holds the test to that contract) */
+    double f0_3[] = {1.0, 0.0, 0.0}, f1_3[] = {0.0, 1.0, 0.0};
+    EXPECT(fricont_path_new_affine(p, f0_3, f1_3, 3, &path), FRICONT_ERR_LENGTH, "n = 2");
     EXPECT(fricont_path_new_affine(p, f0, f1, -2, &path), FRICONT_ERR_LENGTH, "n = -2");
     double fnan[] = {0.0, NAN};
     EXPECT(fricont_path_new_affine(p, f0, fnan, 2, &path), FRICONT_ERR_NONFINITE, "f1");
@@ -798,6 +835,12 @@ static void test_host_input(void) {
     EXPECT(fricont_problem_new_solve(1, diag_solve, &sd, NULL, 1, &nm, &tm, &p), FRICONT_ERR_LENGTH, "N is 1x2");
     EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 0, &nm, &tm, &p), FRICONT_ERR_LENGTH, "max_block");
     EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 1, NULL, &tm, &p), FRICONT_ERR_NULL, "N");
+    /* 2p > n: two contact nodes on two dofs, refused at once (the header's LENGTH) */
+    int64_t rp22[] = {0, 1, 2}, ci22[] = {0, 1};
+    double v22[] = {1.0, 1.0};
+    fricont_csr n22 = mk(2, 2, 2, rp22, ci22, v22, 0);
+    EXPECT(fricont_problem_new_solve(2, diag_solve, &sd, NULL, 1, &n22, &n22, &p), FRICONT_ERR_LENGTH,
+           "2p = 4 exceeds n = 2");
     /* fatal, recoverable twice, recoverable once (then fine) */
     int codes[3] = {-3, 5, 5}, times[3] = {1, 2, 1};
     fricont_status wants[3] = {FRICONT_ERR_SOLVE_CALLBACK, FRICONT_ERR_SOLVE_CALLBACK, FRICONT_OK};
@@ -965,8 +1008,80 @@ static void test_no_threads_started(void) {
 #endif
 }
 
+/* Extreme but valid scales of A: the block with A and f multiplied by s (A = diag(2s, s),
+ * f = s (1, alpha)) is the same problem with lambda times s, so the event stays at
+ * alpha = 1/2 with lambda = s (-1, -1/2), and u at alpha = 2 stays (0, 3/2).
+ * s = 8e307: the diagonal 1.6e308 overflowed the mean (a + b)/2 of full storage;
+ * s = 1e-310: subnormal entries gave "relative pivot NaN"; s = 2^-1000 is exact;
+ * s = 1e-315 (29 significant bits) is refused with a range error. */
+static void test_extreme_scales(void) {
+    const double scales[] = {8e307, 1e-310, 9.332636185032189e-302 /* 2^-1000 */};
+    for (int k = 0; k < 3; k++) {
+        double sc = scales[k];
+        double av[] = {2.0 * sc, sc}, g0[] = {sc, 0.0}, g1[] = {0.0, sc};
+        for (int32_t storage = 0; storage < 3; storage++) {
+            fricont_csr a = mk(2, 2, 2, a_rp, a_ci, av, 0), n = mk(1, 2, 1, n_rp, n_ci, n_v, 0),
+                        t = mk(1, 2, 1, t_rp, t_ci, t_v, 0);
+            fricont_problem *p = NULL;
+            fricont_path *path = NULL;
+            EXPECT(fricont_problem_new(&a, storage, &n, &t, &p), FRICONT_OK, "");
+            EXPECT(fricont_problem_set_friction(p, 0.5), FRICONT_OK, "");
+            fricont_status st = fricont_problem_build(p);
+            CHECK(st == FRICONT_OK, "A x %g, storage %d: %s: %s", sc, storage, fricont_status_str(st), last());
+            EXPECT(fricont_path_new_affine(p, g0, g1, 2, &path), FRICONT_OK, "");
+            EXPECT(fricont_path_set_window(path, 0.0, 2.0), FRICONT_OK, "");
+            EXPECT(fricont_path_start(path, 0.0, NULL, 0), FRICONT_OK, "");
+            EXPECT(fricont_path_run(path), FRICONT_END, "");
+            int64_t count = 0;
+            fricont_event ev = {0};
+            EXPECT(fricont_path_event_count(path, &count), FRICONT_OK, "");
+            EXPECT(fricont_path_event(path, 0, &ev), FRICONT_OK, "");
+            double u[2], ln[1], lt[1];
+            fricont_state s = {0, 0, u, 2, ln, 1, lt, 1, NULL, 0};
+            EXPECT(fricont_path_event_state(path, 0, &s), FRICONT_OK, "");
+            CHECK(count == 1 && fabs(ev.alpha - 0.5) < 1e-14 && ev.from == FRICONT_STICK &&
+                      ev.to == FRICONT_SLIP_PLUS && fabs(ln[0] / sc + 1) < 1e-9 &&
+                      fabs(lt[0] / sc + 0.5) < 1e-9 && s.residual <= 1e-12,
+                  "A x %g, storage %d: %lld events, alpha %.17g, lambda %g %g, residual %g", sc, storage,
+                  (long long)count, ev.alpha, ln[0] / sc, lt[0] / sc, s.residual);
+            EXPECT(fricont_path_current(path, &s), FRICONT_OK, "");
+            CHECK(fabs(u[0]) < 1e-9 && fabs(u[1] - 1.5) < 1e-9 && s.alpha == 2.0,
+                  "A x %g: u at alpha = 2: %g %g", sc, u[0], u[1]);
+            fricont_path_free(path);
+            fricont_problem_free(p);
+        }
+    }
+    /* 1e-315: fewer than 40 significant bits */
+    double avs[] = {2e-315, 1e-315};
+    fricont_csr a = mk(2, 2, 2, a_rp, a_ci, avs, 0), n = mk(1, 2, 1, n_rp, n_ci, n_v, 0),
+                t = mk(1, 2, 1, t_rp, t_ci, t_v, 0);
+    fricont_problem *p = NULL;
+    EXPECT(fricont_problem_new(&a, FRICONT_STORAGE_FULL, &n, &t, &p), FRICONT_OK, "");
+    EXPECT(fricont_problem_build(p), FRICONT_ERR_RANGE, "subnormal");
+    fricont_problem_free(p);
+    /* a tiny A with an ordinary load pulling the block off (open): u = A^-1 f would
+     * overflow */
+    double atiny[] = {2e-310, 1e-310}, pull[] = {-1.0, 0.0};
+    a.values = atiny;
+    EXPECT(fricont_problem_new(&a, FRICONT_STORAGE_FULL, &n, &t, &p), FRICONT_OK, "");
+    fricont_path *path = NULL;
+    EXPECT(fricont_path_new_affine(p, pull, f1, 2, &path), FRICONT_OK, "");
+    EXPECT(fricont_path_set_window(path, 0.0, 2.0), FRICONT_OK, "");
+    EXPECT(fricont_path_start(path, 0.0, NULL, 0), FRICONT_ERR_NUMERICAL, "overflows");
+    fricont_path_free(path);
+    fricont_problem_free(p);
+    /* not symmetric near the largest double: the message has the caller's numbers */
+    int64_t rp[] = {0, 2, 3}, ci[] = {0, 1, 1};
+    double v[] = {1.6e308, 1e308, 8e307};
+    fricont_csr b = mk(2, 2, 3, rp, ci, v, 0);
+    EXPECT(fricont_problem_new(&b, FRICONT_STORAGE_FULL, &n, &t, &p), FRICONT_OK, "");
+    EXPECT(fricont_problem_build(p), FRICONT_ERR_NOT_SYMMETRIC, "differ by 1e308");
+    fricont_problem_free(p);
+}
+
 int main(void) {
     test_strings();
+    test_extreme_scales();
     test_csr_errors();
     test_problem_setters();
     test_path_construction();

@@ -934,7 +934,9 @@ fricont_status fricont_problem_set_gap(struct fricont_problem *problem,
  * H3 = λt − P_[−b,b](λt − r T u) with b = max(−F λν, 0).
  * Solutions, classes and transition points do not depend on r; it scales the
  * rows H2, H3 and so the reported residuals. Default: r = 2p / trace(W), the reciprocal
- * of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ. Changing r keeps the
+ * of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ of the equilibrated rows
+ * (each node's rows of N, T scaled to unit norm, and by a power of two for an A whose
+ * largest entry lies outside [2^-64, 2^64]; the README's "Conventions"). Changing r keeps the
  * factorisation (no new Cholesky of A).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (r ≤ 0 or not
@@ -971,14 +973,22 @@ fricont_status fricont_problem_set_threads(struct fricont_problem *problem,
  * computes a sparse Cholesky factorisation of A (the dofs B touches ordered last) and the
  * Delassus operator W = B A⁻¹ Bᵀ from the trailing block of the factor (or by 2p solves
  * when B's rows are wide, or with the host's solve; a condensed W is checked instead),
- * and checks that W is positive definite (B = [N; T] of full row rank). Optional: `fricont_path_new_*` builds when
+ * and checks that W is positive definite (B = [N; T] of full row rank). Extreme but
+ * valid scales of A work (entries of 1e300 or 1e-310, with loads of the same size): an
+ * A whose largest entry lies outside [2^-64, 2^64] is factorised as 2^k A (exact, k
+ * bringing it into [1, 4)) and results are reported in the caller's units; a load that
+ * makes u overflow a double gives `FRICONT_ERR_NUMERICAL` where u is computed (the start
+ * of a path). Optional: `fricont_path_new_*` builds when
  * needed; call it to see data errors early or to time the set-up. A no-op when nothing
  * changed since the last build.
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_NOT_SYMMETRIC`,
  * `FRICONT_ERR_NOT_SPD`, `FRICONT_ERR_RANK_DEFICIENT`, `FRICONT_ERR_CSR` (an entry of A in
  * the wrong triangle for the storage), `FRICONT_ERR_LENGTH` (2p > n), `FRICONT_ERR_RANGE`
- * (an r set outside [1e-6, 1e6] × the default 2p / trace(W)),
+ * (an r set outside [1e-6, 1e6] × the default 2p / trace(W); or A's largest entry a
+ * subnormal number below 2^-1034 ≈ 5.4e-312, fewer than 40 significant bits: multiply A
+ * and the loads by one power of two), `FRICONT_ERR_NUMERICAL` (W = B A⁻¹ Bᵀ beyond the
+ * range of a double: A numerically singular),
  * `FRICONT_ERR_OUT_OF_MEMORY` (the factor, W or a copy of the data cannot be allocated:
  * the message says how much was asked; the handle stays usable),
  * `FRICONT_ERR_SOLVE_CALLBACK` (the host's solve failed), `FRICONT_ERR_POISONED`,

@@ -180,6 +180,9 @@ enum Operator {
 pub struct Delassus {
     n: usize,
     op: Operator,
+    /// `h = 2^(k/2)` of the exact scaling of A ([`crate::Problem::a_scale_log2`]; 1 for
+    /// ordinary A): the factor is that of `h² A`, and loads enter as `h f`.
+    h: f64,
     b: CsrMatrix,
     w: Mat<f64>,
     /// `Z = L_SS⁻¹ B_Sᵀ` (s × 2p, rows in the factor's order) when W came from the trailing
@@ -192,6 +195,11 @@ impl Delassus {
     /// Factorises `A` given by its lower triangle (CSR, row ≥ col; as CSC this is the upper
     /// triangle of the symmetric matrix) and forms `W` for `B` (2p×n).
     ///
+    /// `h` (a power of two; 1 for ordinary data) says that `a_lower` is the caller's A
+    /// times `h²` (see [`crate::Problem::a_scale_log2`]): `W = B (h² A)⁻¹ Bᵀ` is then W for
+    /// the rows `B / h`, and the functions taking a load `f` and giving `u` work with the
+    /// caller's f and u (`A⁻¹ f = h (h² A)⁻¹ (h f)`).
+    ///
     /// Errors: [`Error::NotSpd`] with the failing pivot, [`Error::RankDeficient`] when `W`
     /// is not numerically positive definite (a pivot of its Cholesky factor below 1e-12
     /// of the corresponding diagonal entry), [`Error::Numerical`] when faer runs out of
@@ -200,7 +208,7 @@ impl Delassus {
     /// `par`: the parallelism of the numeric factorisation and of forming W
     /// (`Par::Seq`, or `Par::rayon(n)` inside a private rayon pool, see
     /// [`crate::ProblemBuilder::threads`]).
-    pub fn new(a_lower: &CsrMatrix, b: &CsrMatrix, par: Par) -> Result<Self> {
+    pub fn new(a_lower: &CsrMatrix, b: &CsrMatrix, h: f64, par: Par) -> Result<Self> {
         let n = a_lower.nrows();
         // CSR of the lower triangle == CSC of the upper triangle.
         let symb =
@@ -288,6 +296,7 @@ impl Delassus {
         let mut this = Self {
             n,
             op: Operator::Cholesky { symbolic, l_values },
+            h,
             b: b.clone(),
             w: Mat::zeros(0, 0),
             z: None,
@@ -407,7 +416,7 @@ impl Delassus {
                     xb[(j, c)] = v;
                 }
             }
-            self.solve_mat_in_place(xb.as_mut())?;
+            self.solve_scaled(xb.as_mut())?;
             for i in 0..m {
                 for c in 0..k {
                     w[(i, col0 + c)] = self.b.row(i).map(|(j, v)| v * xb[(j, c)]).sum();
@@ -434,6 +443,16 @@ impl Delassus {
         for j in 0..m {
             if self.w[(j, j)] <= 0.0 {
                 return Err(Error::RankDeficient(format!("{} is zero", name(j))));
+            }
+        }
+        for j in 0..m {
+            if let Some(i) = (0..m).find(|&i| !self.w[(i, j)].is_finite()) {
+                return Err(Error::Numerical(format!(
+                    "W = B A^-1 B^T has the entry W({}, {}) = {} (1-based): A^-1 is beyond the range of a double (A numerically singular?)",
+                    i + 1,
+                    j + 1,
+                    self.w[(i, j)]
+                )));
             }
         }
         let dependent = |j: usize, d: f64| {
@@ -486,8 +505,9 @@ impl Delassus {
         self.z.is_some()
     }
 
-    /// The forward half of a solve with A: `Y = L⁻¹ Pᵀ X` in place for every column of `x`
-    /// (n rows), in the factor's order. Errors: [`Error::Usage`] without
+    /// The forward half of a solve with A: `Y = L⁻¹ Pᵀ (h X)` in place for every column of
+    /// `x` (n rows, the caller's loads; `h` as in [`Self::new`]), in the factor's order.
+    /// Errors: [`Error::Usage`] without
     /// [`Self::has_half_solve`].
     pub(crate) fn half_solve(&self, mut x: MatMut<'_, f64>) -> Result<()> {
         let (llt, fwd) = self.supernodal()?;
@@ -495,7 +515,7 @@ impl Delassus {
         let mut col = vec![0.0; self.n];
         for c in 0..k {
             for (i, &j) in fwd.iter().enumerate() {
-                col[i] = x[(j, c)];
+                col[i] = self.h * x[(j, c)];
             }
             for (i, v) in col.iter().enumerate() {
                 x[(i, c)] = *v;
@@ -519,9 +539,10 @@ impl Delassus {
             .collect()
     }
 
-    /// `u = A⁻¹ (f + Bᵀ λ)` for every column, from the half-solved loads `y = L⁻¹ Pᵀ f`
-    /// (n × k, overwritten) and the contact forces `lam` (2p × k, equilibrated rows):
-    /// `L⁻¹ Pᵀ Bᵀ λ = (0, Z λ)`, so only the backward half `P L⁻ᵀ (y + (0, Z λ))` touches
+    /// `u = A⁻¹ (f + (B / h)ᵀ λ)` for every column, from the half-solved loads
+    /// `y = L⁻¹ Pᵀ h f` (n × k, overwritten) and the contact forces `lam` (2p × k,
+    /// equilibrated rows): `L⁻¹ Pᵀ Bᵀ λ = (0, Z λ)`, and u is h times the solution of the
+    /// factorised `h² A`, so only the backward half `P L⁻ᵀ (y + (0, Z λ))` touches
     /// the whole factor. Errors: [`Error::Usage`] without [`Self::has_half_solve`]; out of
     /// memory.
     pub(crate) fn displacements(
@@ -546,8 +567,9 @@ impl Delassus {
         let mut u = try_zeros(n, k, "the displacements u")?;
         for c in 0..k {
             for (i, &j) in fwd.iter().enumerate() {
-                u[(j, c)] = y[(i, c)];
+                u[(j, c)] = self.h * y[(i, c)];
             }
+            check_u(&u.col(c).iter().copied().collect::<Vec<_>>())?;
         }
         Ok(u)
     }
@@ -578,7 +600,8 @@ impl Delassus {
         })
     }
 
-    /// `B = [N; T]`.
+    /// `B = [N; T]` with the equilibrated rows the factor is used with: `h` times
+    /// [`crate::Problem::b`] (`h` as in [`Self::new`], 1 for ordinary data).
     pub fn b(&self) -> &CsrMatrix {
         &self.b
     }
@@ -610,9 +633,27 @@ impl Delassus {
         }
     }
 
-    /// Solves `A X = X` in place for every column of `x` (n rows). Errors: the host's
-    /// solve failed ([`Error::HostSolve`]); condensed input ([`Error::NoDisplacement`]).
-    pub fn solve_mat_in_place(&self, x: MatMut<'_, f64>) -> Result<()> {
+    /// Solves `A X = X` in place for every column of `x` (n rows), with the caller's A.
+    /// Errors: the host's solve failed ([`Error::HostSolve`]); condensed input
+    /// ([`Error::NoDisplacement`]).
+    pub fn solve_mat_in_place(&self, mut x: MatMut<'_, f64>) -> Result<()> {
+        // A⁻¹ x = h (h² A)⁻¹ (h x): both products by h are exact, and every intermediate
+        // stays in the range of the data.
+        if self.h != 1.0 {
+            x *= faer::Scale(self.h);
+        }
+        self.solve_scaled(x.as_mut())?;
+        if self.h != 1.0 {
+            x *= faer::Scale(self.h);
+        }
+        for c in 0..x.ncols() {
+            check_u(&x.as_ref().col(c).iter().copied().collect::<Vec<_>>())?;
+        }
+        Ok(())
+    }
+
+    /// Solves with the matrix that was factorised (`h² A`, see [`Self::new`]).
+    fn solve_scaled(&self, x: MatMut<'_, f64>) -> Result<()> {
         match &self.op {
             Operator::Cholesky { symbolic, l_values } => {
                 let par = Par::Seq;
@@ -638,26 +679,41 @@ impl Delassus {
         self.solve_mat_in_place(mat)
     }
 
-    /// `q = B A⁻¹ f` (2p entries, equilibrated rows) for a load vector `f` (n entries);
+    /// `q = (B / h) A⁻¹ f` (2p entries, the rows of [`crate::Problem::b`]) for a load
+    /// vector `f` (n entries, the caller's units; `h` as in [`Self::new`]);
     /// for condensed input `f` is already `q` in the caller's rows, and only the
     /// equilibration is applied. Errors: the host's solve failed.
     pub fn condense(&self, f: &[f64]) -> Result<Vec<f64>> {
         if let Operator::Condensed { row_scale } = &self.op {
             return Ok(f.iter().zip(row_scale).map(|(v, s)| v / s).collect());
         }
-        let mut x = f.to_vec();
-        self.solve_in_place(&mut x)?;
+        // B (h² A)⁻¹ (h f) = (B / h) A⁻¹ f
+        let mut x: Vec<f64> = f.iter().map(|v| self.h * v).collect();
+        let n = x.len();
+        self.solve_scaled(faer::MatMut::from_column_major_slice_mut(&mut x, n, 1))?;
         let mut q = vec![0.0; self.b.nrows()];
         self.b.mul_vec(&x, &mut q);
+        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            return Err(Error::Numerical(format!(
+                "the condensed load q = B A^-1 f overflows (row {} is {}): the load is too large for this A",
+                i + 1,
+                q[i]
+            )));
+        }
         Ok(q)
     }
 
-    /// The displacement `u = A⁻¹ (f + Bᵀ λ)` (one back-solve). Errors as
+    /// The displacement `u = A⁻¹ (f + (B / h)ᵀ λ)` (one back-solve; `h` as in
+    /// [`Self::new`], 1 for ordinary data), for the caller's f and u. Errors as
     /// [`Self::solve_mat_in_place`].
     pub fn displacement(&self, f: &[f64], lambda: &[f64]) -> Result<Vec<f64>> {
-        let mut x = f.to_vec();
+        // h (h² A)⁻¹ (h f + Bᵀ λ)
+        let mut x: Vec<f64> = f.iter().map(|v| self.h * v).collect();
         self.b.mul_t_vec_add(lambda, &mut x);
-        self.solve_in_place(&mut x)?;
+        let n = x.len();
+        self.solve_scaled(faer::MatMut::from_column_major_slice_mut(&mut x, n, 1))?;
+        x.iter_mut().for_each(|v| *v *= self.h);
+        check_u(&x)?;
         Ok(x)
     }
 
@@ -670,6 +726,7 @@ impl Delassus {
         let mut this = Self {
             n,
             op: Operator::Host(solve),
+            h: 1.0,
             b: b.clone(),
             w: Mat::zeros(0, 0),
             z: None,
@@ -710,11 +767,25 @@ impl Delassus {
         Self {
             n: 0,
             op: Operator::Condensed { row_scale },
+            h: 1.0,
             b: CsrMatrix::from_triplets("B", w.nrows(), 0, &[]).expect("an empty matrix"),
             w,
             z: None,
             times: SetupTimes::default(),
         }
+    }
+}
+
+/// A displacement that is not finite: the caller's u does not fit in a double (a tiny A
+/// and a large load): [`Error::Numerical`] instead of an infinite u.
+fn check_u(u: &[f64]) -> Result<()> {
+    match u.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(Error::Numerical(format!(
+            "the displacement u overflows (entry {} is {}): u = A^-1 (f + B^T lambda) is beyond the range of a double for this A and load (A tiny compared with f? scale A and the loads alike)",
+            i + 1,
+            u[i]
+        ))),
     }
 }
 
@@ -729,7 +800,7 @@ fn no_displacement() -> Error {
 fn symmetrise(w: &mut Mat<f64>) {
     for i in 0..w.nrows() {
         for j in 0..i {
-            let s = 0.5 * (w[(i, j)] + w[(j, i)]);
+            let s = 0.5 * w[(i, j)] + 0.5 * w[(j, i)];
             w[(i, j)] = s;
             w[(j, i)] = s;
         }

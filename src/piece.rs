@@ -498,11 +498,39 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// node `B u` vanishes by cancellation inside u (`|B||u|` is 0 there), while its rounding
 /// is that of `W λ`, which H2 and H3 multiply by r.
 ///
+/// B, λ, g and r are those of the equilibrated rows ([`Problem::b`]); an A of extreme
+/// size enters as it was factorised (H1 times `2^(k/2)`, k = [`Problem::a_scale_log2`],
+/// 0 for ordinary data), so that H1 is measured in the units of the forces of H2, H3.
+///
 /// Without A (a host's solve, or condensed input) H1 is not evaluated. With a host's
 /// solve `B u` comes from its u; for condensed input (u empty, `f` the condensed load q)
 /// `B u = q + W λ`, with `|q| + |W||λ|` as its terms' magnitude.
 pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
     let (n, p, r) = (problem.n(), problem.p(), problem.r());
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !(finite(u) && finite(lam) && finite(f)) {
+        return f64::INFINITY;
+    }
+    // Terms near the end of the range of doubles (a load of 1e308, u of 1e308) would
+    // overflow in the sums below: u, f, λ and g are multiplied by a power of two σ first,
+    // which does not change H / scale (H is homogeneous of degree one in them).
+    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let big = inf(u)
+        .max(inf(f))
+        .max(inf(lam))
+        .max(inf(problem.gap_equilibrated()));
+    let sigma_log2 = if big > 0.0 && !(2f64.powi(-500)..=2f64.powi(500)).contains(&big) {
+        -(big.log2().ceil() as i32)
+    } else {
+        0
+    };
+    let sigma = |v: &[f64]| -> Vec<f64> {
+        v.iter()
+            .map(|&x| crate::problem::mul_pow2(x, sigma_log2))
+            .collect()
+    };
+    let (u, lam, f) = (&sigma(u)[..], &sigma(lam)[..], &sigma(f)[..]);
+    let gap = sigma(problem.gap_equilibrated());
     let mut h = 0.0f64;
     let mut scale = 1e-300f64;
     let mut bu = vec![0.0; 2 * p];
@@ -515,6 +543,7 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
             .condense(f)
             .unwrap_or_else(|_| vec![f64::NAN; 2 * p]);
         for i in 0..2 * p {
+            // (condense is linear: q of the scaled load)
             bu[i] = q[i];
             bu_abs[i] = q[i].abs();
             for (j, &l) in lam.iter().enumerate() {
@@ -531,26 +560,32 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
         }
     }
     if let Some(a) = problem.a() {
+        // H1 of the problem as factorised, 2^(k/2) (A u − f − Bᵀ λ) with A scaled by 2^k
+        // (k = a_scale_log2, 0 for ordinary data): every product below is between
+        // numbers of the range that was factorised (exact scalings by powers of two).
+        let hs = crate::problem::mul_pow2(1.0, problem.a_scale_log2() / 2);
+        let u_s: Vec<f64> = u.iter().map(|v| v / hs).collect();
         let mut btl = vec![0.0; n];
         let mut btl_abs = vec![0.0; n];
         for (i, &l) in lam.iter().enumerate() {
             for (j, v) in problem.b().row(i) {
-                btl[j] += v * l;
-                btl_abs[j] += (v * l).abs();
+                btl[j] += hs * v * l;
+                btl_abs[j] += (hs * v * l).abs();
             }
         }
         for i in 0..n {
             let (mut au, mut au_abs) = (0.0, 0.0);
             for (j, v) in a.row(i) {
-                au += v * u[j];
-                au_abs += (v * u[j]).abs();
+                au += v * u_s[j];
+                au_abs += (v * u_s[j]).abs();
             }
-            h = h.max((au - f[i] - btl[i]).abs());
-            scale = scale.max(au_abs).max(f[i].abs()).max(btl_abs[i]);
+            let fi = hs * f[i];
+            h = h.max((au - fi - btl[i]).abs());
+            scale = scale.max(au_abs).max(fi.abs()).max(btl_abs[i]);
         }
     }
     for i in 0..p {
-        let g = problem.gap_equilibrated()[i];
+        let g = gap[i];
         let (ln, lt) = (lam[i], lam[p + i]);
         let h2 = ln - (ln - r * (bu[i] - g)).min(0.0);
         let b = (-problem.friction()[i] * ln).max(0.0);
@@ -565,7 +600,12 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
     }
     let lam_max = lam.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     scale = scale.max(r * problem.w_norm() * lam_max);
-    if h.is_nan() { f64::INFINITY } else { h / scale }
+    // (f64::max drops NaN: a NaN term shows in the sums, h or the scale)
+    if h.is_finite() && scale.is_finite() && finite(&bu) {
+        h / scale
+    } else {
+        f64::INFINITY
+    }
 }
 
 #[cfg(test)]

@@ -329,6 +329,13 @@ impl CsrMatrix {
     pub fn max_abs(&self) -> f64 {
         self.values.iter().fold(0.0, |m, v| m.max(v.abs()))
     }
+
+    /// Multiplies every value by `2^e` (exact unless a value leaves the normal range).
+    pub(crate) fn scale_pow2(&mut self, e: i32) {
+        if e != 0 {
+            self.values.iter_mut().for_each(|v| *v = mul_pow2(*v, e));
+        }
+    }
 }
 
 /// Which part of the symmetric matrix `A` the caller stores.
@@ -471,7 +478,13 @@ impl ProblemBuilder {
     /// caller's W, with the pivot), [`Error::RankDeficient`]
     /// (B = [N; T] without full row rank 2p), [`Error::HostSolve`] (the host's solve
     /// failed), [`Error::InvalidParameter`] (F < 0 or not
-    /// finite, r ≤ 0 or not finite or `r / r0` outside [`R_RANGE`], p = 0).
+    /// finite, r ≤ 0 or not finite or `r / r0` outside [`R_RANGE`], p = 0, A's largest
+    /// entry a subnormal number below 2^-1034 ≈ 5.4e-312, i.e. with fewer than 40
+    /// significant bits).
+    ///
+    /// Extreme but valid scales of A work: A is factorised as `2^k A` with k from its
+    /// largest entry (see [`Problem::a_scale_log2`]), so A × 4e307 or A × 1e-310 with the
+    /// loads scaled alike give the transition points of A.
     pub fn build(self) -> Result<Problem> {
         let p = match &self.source {
             Source::Matrix { n, .. } | Source::Solve { n, .. } => n.nrows(),
@@ -569,8 +582,13 @@ impl ProblemBuilder {
                 "r = {r}, must be finite and > 0"
             )));
         }
-        let (a, b, node_scale, delassus) = match self.source {
-            Source::Matrix { a, storage, n, t } => {
+        let (a, b, node_scale, delassus, a_scale_log2) = match self.source {
+            Source::Matrix {
+                mut a,
+                storage,
+                n,
+                t,
+            } => {
                 // The copies of A made below (both triangles, the lower one, a transpose)
                 // and the per-dof arrays of the ordering, asked for at once so that a
                 // problem too large for the memory fails here cleanly instead of aborting
@@ -579,21 +597,32 @@ impl ProblemBuilder {
                     4 * a.nnz() * 16 + 8 * n_dofs * 8,
                     "the copies of A and the ordering",
                 )?;
-                let (lower, full_a) = lower_and_full(&a, storage)?;
-                let (b, node_scale) = equilibrated_b(&n, &t, n_dofs)?;
-                let del = with_threads(self.threads, |par| Delassus::new(&lower, &b, par))?;
-                (Some(full_a), b, node_scale, del)
+                check_a_precision(a.max_abs())?;
+                let (b_unit, unit_scale) = equilibrated_b(&n, &t, n_dofs)?;
+                // A far from 1 in size (4e307, or subnormal entries) is scaled by an
+                // exact power of four before anything else is computed from it; the
+                // square root of that power goes into the node scales (see
+                // `stiffness_exponent`).
+                let k = stiffness_exponent(a.max_abs(), &unit_scale);
+                a.scale_pow2(k);
+                let (lower, full_a) = lower_and_full(&a, storage, k)?;
+                let h = mul_pow2(1.0, k / 2);
+                let del = with_threads(self.threads, |par| Delassus::new(&lower, &b_unit, h, par))?;
+                let mut b = b_unit;
+                b.scale_pow2(-k / 2);
+                let node_scale = unit_scale.iter().map(|s| s * h).collect();
+                (Some(full_a), b, node_scale, del, k)
             }
             Source::Solve { solve, n, t, .. } => {
                 let (b, node_scale) = equilibrated_b(&n, &t, n_dofs)?;
                 let del = Delassus::from_host_solve(n_dofs, solve, &b)?;
-                (None, b, node_scale, del)
+                (None, b, node_scale, del, 0)
             }
             Source::Condensed { w } => {
                 let (w_int, node_scale) = equilibrated_w(w)?;
                 let row_scale = (0..2 * p).map(|k| node_scale[k % p]).collect();
                 let del = Delassus::from_condensed(w_int, row_scale);
-                (None, del.b().clone(), node_scale, del)
+                (None, del.b().clone(), node_scale, del, 0)
             }
         };
         let gap_eq: Vec<f64> = gap.iter().zip(&node_scale).map(|(g, s)| g / s).collect();
@@ -614,12 +643,74 @@ impl ProblemBuilder {
             gap,
             gap_eq,
             node_scale,
+            a_scale_log2,
             r,
             r_default,
             w_norm,
             delassus,
         })
     }
+}
+
+/// The largest entries of A outside `[2^-A_BAND, 2^A_BAND]` are scaled into `[1, 4)`.
+const A_BAND: i32 = 64;
+
+/// The exponent k (even) of the exact scaling `2^k A` under which fricont factorises A:
+/// 0 when the largest entry `max_abs` lies within `[2^-64, 2^64]` (nothing changes for
+/// ordinary data), otherwise the one that brings it into `[1, 4)`. A stiffness of 4e307
+/// would otherwise give a W with subnormal entries (and a trace that overflows), and one
+/// with subnormal entries (1e-310) a meaningless factorisation.
+///
+/// The problem `(A, f, λ, u, g)` is the same as
+/// `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u, 2^(-k/2) g)` with `B` unchanged; fricont
+/// factorises the latter, and traces with the rows of B divided by `2^(k/2)` on top of
+/// the node's own scale (forces `2^(k/2) λ` then pair with the caller's u and g), so W,
+/// q and the forces the path works with stay in the range of ordinary numbers, and
+/// reports the former. The node scales
+/// `unit_scale[i] · 2^(k/2)` must stay within `[2^-1000, 2^1000]`: k is moved toward 0
+/// as far as they require (only for rows of N, T of absurd size).
+fn stiffness_exponent(max_abs: f64, unit_scale: &[f64]) -> i32 {
+    let band = mul_pow2(1.0, -A_BAND)..=mul_pow2(1.0, A_BAND);
+    if max_abs.is_nan() || max_abs <= 0.0 || band.contains(&max_abs) {
+        return 0;
+    }
+    // 2^e ≤ max_abs < 2^(e + 1) (up to the rounding of log2), so 4^half max_abs ∈ [1, 4).
+    let e = max_abs.log2().floor() as i32;
+    let half = -e.div_euclid(2);
+    let smax = unit_scale.iter().fold(1.0f64, |m, &s| m.max(s));
+    let smin = unit_scale.iter().fold(1.0f64, |m, &s| m.min(s));
+    let hi = (1000.0 - smax.log2()).floor() as i32;
+    let lo = (-1000.0 - smin.log2()).ceil() as i32;
+    2 * half.min(hi).max(lo)
+}
+
+/// The smallest largest entry of A accepted: below it A is subnormal with fewer than 40
+/// significant bits (a normwise rounding of the data itself above 2^-40 ≈ 1e-12).
+const A_MIN_MAX_ABS_LOG2: i32 = -1034;
+
+/// A whose largest entry is a subnormal number of fewer than 40 significant bits cannot
+/// be represented to the accuracy fricont reports ([`Error::InvalidParameter`], saying
+/// how to rescale). Larger subnormal scales (1e-310: 44 bits) are accepted.
+fn check_a_precision(max_abs: f64) -> Result<()> {
+    if max_abs > 0.0 && max_abs < mul_pow2(1.0, A_MIN_MAX_ABS_LOG2) {
+        let bits = (max_abs / f64::from_bits(1)).log2().floor() + 1.0;
+        return Err(Error::InvalidParameter(format!(
+            "the largest entry of A is {max_abs:e}, a subnormal number with {bits} significant bits: A cannot be represented at this scale (fricont needs at least 40 bits, |A| ≥ 2^{A_MIN_MAX_ABS_LOG2} ≈ {:e}); multiply A and the loads by the same power of two 2^k (transition points do not change, λ scales by 2^k)",
+            mul_pow2(1.0, A_MIN_MAX_ABS_LOG2)
+        )));
+    }
+    Ok(())
+}
+
+/// `x · 2^e`, exact whenever the result is a normal number (in up to three steps, since
+/// `2^e` itself may not be representable).
+pub(crate) fn mul_pow2(mut x: f64, mut e: i32) -> f64 {
+    while e != 0 {
+        let s = e.clamp(-1000, 1000);
+        x *= f64::from_bits(((1023 + s) as u64) << 52);
+        e -= s;
+    }
+    x
 }
 
 /// Equilibration: node i's rows N_i, T_i (and gap g_i) divided by
@@ -705,7 +796,8 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
     let mut w_int = try_zeros(m, m, "the equilibrated W")?;
     for j in 0..m {
         for i in 0..m {
-            w_int[(i, j)] = 0.5 * (w[(i, j)] + w[(j, i)]) / (sc(i) * sc(j));
+            // (no overflow for entries near f64::MAX)
+            w_int[(i, j)] = (0.5 * w[(i, j)] + 0.5 * w[(j, i)]) / (sc(i) * sc(j));
         }
     }
     let pivot_err = |j: usize, d: f64| {
@@ -730,8 +822,14 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
 }
 
 /// Lower triangle (row ≥ col) and full storage of A, checking the storage convention and,
-/// for full storage, symmetry. Linear in the number of entries (no sorting).
-fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatrix)> {
+/// for full storage, symmetry. Linear in the number of entries (no sorting). `a` is the
+/// caller's A times `2^scale_log2` (see [`stiffness_exponent`]): messages report the caller's
+/// numbers.
+fn lower_and_full(
+    a: &CsrMatrix,
+    storage: Storage,
+    scale_log2: i32,
+) -> Result<(CsrMatrix, CsrMatrix)> {
     let n = a.nrows();
     let keep = |m: &CsrMatrix, lower: bool| {
         let mut rp = vec![0usize; n + 1];
@@ -793,8 +891,8 @@ fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatr
                             c + 1,
                             c + 1,
                             i + 1,
-                            d.abs(),
-                            tol
+                            mul_pow2(d.abs(), -scale_log2),
+                            mul_pow2(tol, -scale_log2)
                         )));
                     }
                 }
@@ -814,7 +912,8 @@ fn lower_and_full(a: &CsrMatrix, storage: Storage) -> Result<(CsrMatrix, CsrMatr
                         Some(&(c, w)) if c == j => w,
                         _ => 0.0,
                     };
-                    sym.values[k] = 0.5 * (sym.values[k] + w);
+                    // (no overflow for entries near f64::MAX)
+                    sym.values[k] = 0.5 * sym.values[k] + 0.5 * w;
                 }
             }
             Ok((keep(&sym, true), sym))
@@ -928,6 +1027,7 @@ pub struct Problem {
     /// Equilibrated gap `g_i / s_i`.
     gap_eq: Vec<f64>,
     node_scale: Vec<f64>,
+    a_scale_log2: i32,
     r: f64,
     r_default: f64,
     /// `‖W‖∞` (equilibrated rows).
@@ -958,10 +1058,22 @@ impl Problem {
     pub fn p(&self) -> usize {
         self.p
     }
-    /// The stiffness matrix, full storage; None when the problem was made from a host's
-    /// solve or from condensed data.
+    /// The stiffness matrix, full storage, as fricont uses it: the caller's A (for full
+    /// storage `(A + Aᵀ)/2`) times `2^`[`Problem::a_scale_log2`] (exactly the caller's
+    /// numbers unless A's largest entry lies outside `[2^-64, 2^64]`); None when the
+    /// problem was made from a host's solve or from condensed data.
     pub fn a(&self) -> Option<&CsrMatrix> {
         self.a.as_ref()
+    }
+    /// The exponent k of the exact internal scaling `2^k A` (even; 0 unless A's largest
+    /// entry lies outside `[2^-64, 2^64]`, then the k that brings it into `[1, 4)`).
+    /// Extreme but valid scales (A × 4e307, subnormal entries) are factorised as
+    /// ordinary numbers this way; results are reported in the caller's units. The problem
+    /// `(A, f, λ, u, g)` is factorised as `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u,
+    /// 2^(-k/2) g)`: `2^(k/2)` is part of [`Problem::node_scale`], and the residual of a
+    /// state is that of the scaled equations. 0 for a host's solve and condensed data.
+    pub fn a_scale_log2(&self) -> i32 {
+        self.a_scale_log2
     }
     /// The equilibrated `B = [N; T]` (2p×n; 2p×0 for condensed data): rows `0..p` are N, rows `p..2p` are T, node
     /// i's two rows divided by [`Problem::node_scale`]`[i]`. W, the condensed loads and
@@ -969,8 +1081,9 @@ impl Problem {
     pub fn b(&self) -> &CsrMatrix {
         &self.b
     }
-    /// The scale `s_i = max(‖N_i‖₂, ‖T_i‖₂)` of each node's rows (1 for an empty row); for
-    /// condensed data `sqrt(max(W_ii, W_{p+i,p+i}))`.
+    /// The scale `s_i = max(‖N_i‖₂, ‖T_i‖₂) · 2^(k/2)` of each node's rows (1 for an empty
+    /// row; k = [`Problem::a_scale_log2`], 0 for ordinary A); for condensed data
+    /// `sqrt(max(W_ii, W_{p+i,p+i}))`.
     /// Internal forces are `s_i λ_i` for the caller's `λ_i`.
     pub fn node_scale(&self) -> &[f64] {
         &self.node_scale
@@ -1018,6 +1131,7 @@ impl Problem {
             gap: self.gap.clone(),
             gap_eq: self.gap_eq.clone(),
             node_scale: self.node_scale.clone(),
+            a_scale_log2: self.a_scale_log2,
             r,
             r_default: self.r_default,
             w_norm: self.w_norm,
