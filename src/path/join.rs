@@ -87,22 +87,15 @@ impl Path {
             let c = self.consts();
             let enters = table.iter().all(|row| {
                 let (v, vd) = (row.value, s * row.slope);
-                // Values against the guard's own threshold; slopes (force per unit of
-                // scaled arclength) against the scale of the point.
+                // A guard not at zero must be inside; one at zero (see Tol::at_zero) must
+                // increase: its slope (force per unit of scaled arclength) against the
+                // scale of the point.
                 let form = c.guard_form(row.guard);
-                if v > tol.upper(&form) {
-                    return true;
+                if !tol.at_zero(&form, v, vd) {
+                    return v > 0.0;
                 }
-                let (tv, ts) = (tol.of(&form), tol.slope());
-                if v > tv {
-                    true
-                } else if v < -tv {
-                    false
-                } else if relaxed {
-                    vd >= -ts
-                } else {
-                    vd > ts
-                }
+                let ts = tol.slope();
+                if relaxed { vd >= -ts } else { vd > ts }
             });
             if enters {
                 let orientation = if s > 0.0 {
@@ -152,7 +145,11 @@ impl Path {
         relaxed: bool,
     ) -> Result<Vec<Candidate>> {
         let scale = self.force_scale(pt);
-        let tol = self.tol_at(pt);
+        // A start (no way in) is a point of the fixed-α solver, known to its accuracy.
+        let tol = match back {
+            Some(_) => self.tol_at(pt),
+            None => self.tol_at(pt).approximate(),
+        };
         let options: Vec<Vec<Class>> = self.compatible(nodes, pt, &tol);
         if let Some(k) = options.iter().position(|o| o.is_empty()) {
             return Err(Error::Numerical(format!(
@@ -261,12 +258,16 @@ impl Path {
         let tol = self.tol_at(&pt);
         let c = self.consts();
         let mut nodes: Vec<usize> = crossing.iter().map(|g| g.node).collect();
+        // Guards at zero (Tol::at_zero, with their slopes along the way the path came):
+        // the nodes switching at this point together with the crossing one.
         for GuardRow {
-            guard: g, value: v, ..
-        } in self.guard_table(&cur.classes, &pt, None)
+            guard: g,
+            value: v,
+            slope: vd,
+        } in self.guard_table(&cur.classes, &pt, Some((&cur.t, &cur.rate)))
         {
             let form = c.guard_form(g);
-            if v <= tol.upper(&form) && v <= tol.of(&form) {
+            if v <= 0.0 || tol.at_zero(&form, v, vd) {
                 nodes.push(g.node);
             }
         }

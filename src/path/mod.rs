@@ -291,7 +291,18 @@ pub(super) struct Tol {
     force: f64,
     disp: f64,
     rows: Option<Arc<TolRows>>,
+    /// `zero_tol`: the distance along a unit tangent (scaled coordinates) within which a
+    /// guard's crossing is the point's own (see [`Tol::at_zero`]).
+    arc: f64,
+    /// The uncertainty of a guard's value at the point, as a fraction of [`Tol::of`]:
+    /// [`ROUNDING`] at a point found exactly (a transition point), 1 at a point of the
+    /// fixed-α solver (a start), which is accurate to its 1e-12 only.
+    rounding: f64,
 }
+
+/// The rounding of a guard's value at an exactly computed point, as a fraction of
+/// [`Tol::of`].
+const ROUNDING: f64 = 1e-2;
 
 /// The per-row thresholds of displacement forms, computed on first use: row k costs one
 /// pass over row k of W (`(|W| |λ|)_k`), so a transition pays only for the rows it asks.
@@ -343,7 +354,16 @@ impl Tol {
             force: t,
             disp: t,
             rows: None,
+            arc: 0.0,
+            rounding: 1.0,
         }
+    }
+
+    /// The same thresholds for a point that is known to the fixed-α solver's accuracy
+    /// only (see [`Tol::rounding`]).
+    fn approximate(mut self) -> Self {
+        self.rounding = 1.0;
+        self
     }
 
     /// The threshold for the derivative of a form along a unit tangent (scaled
@@ -361,6 +381,21 @@ impl Tol {
         } else {
             self.force * (f.lam[0].coef.abs() + f.lam[1].coef.abs()).max(1.0)
         }
+    }
+
+    /// True when a guard of value `v` with slope `vd` along a unit tangent (scaled
+    /// coordinates) is at zero at this point: within the rounding of its value (a
+    /// hundredth of [`Self::of`] at a transition point, all of it at a start), or crossing
+    /// zero within `zero_tol` of the point along
+    /// the tangent (`|v| ≤ zero_tol |vd|`), nearer than the point itself is determined.
+    /// A guard that is small against its terms but crosses zero a distinct step away (on
+    /// slender bodies the contact forces are a thousandth of the load's scale, and their
+    /// guards' slopes tiny) is not at zero: it has its own transition.
+    fn at_zero(&self, f: &crate::piece::LinForm, v: f64, vd: f64) -> bool {
+        let a = v.abs();
+        a.is_finite()
+            && ((vd.is_finite() && a <= self.arc * vd.abs())
+                || (a <= self.rounding * self.upper(f) && a <= self.rounding * self.of(f)))
     }
 
     /// An upper bound of [`Self::of`] that costs O(1): a value above it is above the
@@ -700,6 +735,8 @@ impl Path {
             force: z * inf_norm(&pt.lam).max(0.1 * scale),
             disp: z * scale,
             rows: Some(Arc::new(rows)),
+            arc: z,
+            rounding: ROUNDING,
         };
         *self.tol_cache.borrow_mut() = Some((pt.alpha, pt.lam.clone(), tol.clone()));
         tol
