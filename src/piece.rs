@@ -487,20 +487,22 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// H1 = A u − f(α) − Nᵀ λν − Tᵀ λt
 /// H2 = λν − min(λν − r (N u − g), 0)
 /// H3 = λt − P_[−b, b](λt − r T u),   b = max(−F λν, 0)
-/// residual = ‖(H1, H2, H3)‖∞ / max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞, ‖λ‖∞, r‖|B||u|‖∞, r‖g‖∞,
-///                                   r‖W‖∞‖λ‖∞)
+/// residual = max( ‖H1‖∞ / max(‖|A||u|‖∞, ‖f‖∞, ‖|Bᵀ||λ|‖∞),
+///                 max_i max(|H2_i|, |H3_i|) / max(s_i, 1e-3 S) )
+/// s_i = max(|λν_i|, |λt_i|, r (|B||u|)_i, r (|B||u|)_{p+i}, r |g_i|,
+///           r (|W| 1)_i ‖λ‖∞, r (|W| 1)_{p+i} ‖λ‖∞)
+/// S   = the largest of every term above (and of H1's scale)
 /// ```
 ///
-/// The scale is the largest magnitude among the terms of the equations, taken entry by
-/// entry (`|A||u|` rather than `A u`), as in a normwise backward error: it is what
-/// rounding errors are proportional to, and it does not depend on the units of u or f.
-/// The last term is the size of the terms that `B u = q + W λ` is made of: at a contact
-/// node `B u` vanishes by cancellation inside u (`|B||u|` is 0 there), while its rounding
-/// is that of `W λ`, which H2 and H3 multiply by r.
-///
-/// B, λ, g and r are those of the equilibrated rows ([`Problem::b`]); an A of extreme
-/// size enters as it was factorised (H1 times `2^(k/2)`, k = [`Problem::a_scale_log2`],
-/// 0 for ordinary data), so that H1 is measured in the units of the forces of H2, H3.
+/// Each equation is measured against the magnitude of its own terms, taken entry by
+/// entry (`|A||u|` rather than `A u`), as in a backward error: what rounding errors are
+/// proportional to, independent of the units of u and f. H2, H3 are measured node by
+/// node, so that a node far from the foundation (a large gap) or with large forces does
+/// not hide another node's error; a node whose terms are all tiny is measured against a
+/// thousandth of the point's scale S. The `(|W| 1) ‖λ‖∞` terms bound the terms that
+/// `B u = q + W λ` is made of: at a contact node `B u` vanishes by cancellation inside u
+/// (`|B||u|` is 0 there), while its rounding is that of `W λ`, which H2 and H3 multiply
+/// by r.
 ///
 /// Without A (a host's solve, or condensed input) H1 is not evaluated. With a host's
 /// solve `B u` comes from its u; for condensed input (u empty, `f` the condensed load q)
@@ -584,25 +586,43 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
             scale = scale.max(au_abs).max(fi.abs()).max(btl_abs[i]);
         }
     }
+    // H1 relative to its own terms; H2, H3 node by node, relative to the node's terms,
+    // not below a thousandth of the point's force scale (a node far from the foundation
+    // does not set the scale of the others, see the doc above).
+    let h1 = if h > 0.0 { h / scale } else { 0.0 };
+    let lam_max = lam.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let wrow = problem.w_row_sums();
+    let mut global = scale.max(lam_max);
+    for k in 0..2 * p {
+        global = global.max(r * bu_abs[k]).max(r * wrow[k] * lam_max);
+    }
+    let mut hn = 0.0f64;
     for i in 0..p {
         let g = gap[i];
         let (ln, lt) = (lam[i], lam[p + i]);
         let h2 = ln - (ln - r * (bu[i] - g)).min(0.0);
         let b = (-problem.friction()[i] * ln).max(0.0);
         let h3 = lt - (lt - r * bu[p + i]).clamp(-b, b);
-        h = h.max(h2.abs()).max(h3.abs());
-        scale = scale
-            .max(ln.abs())
+        let own = ln
+            .abs()
             .max(lt.abs())
             .max(r * bu_abs[i])
             .max(r * bu_abs[p + i])
-            .max(r * g.abs());
+            .max(r * g.abs())
+            .max(r * wrow[i] * lam_max)
+            .max(r * wrow[p + i] * lam_max);
+        let hi = h2.abs().max(h3.abs());
+        if !(h2.is_finite() && h3.is_finite()) {
+            return f64::INFINITY;
+        }
+        if hi > 0.0 {
+            hn = hn.max(hi / own.max(1e-3 * global));
+        }
     }
-    let lam_max = lam.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    scale = scale.max(r * problem.w_norm() * lam_max);
+    let res = h1.max(hn);
     // (f64::max drops NaN: a NaN term shows in the sums, h or the scale)
-    if h.is_finite() && scale.is_finite() && finite(&bu) {
-        h / scale
+    if res.is_finite() && scale.is_finite() && global.is_finite() && finite(&bu) {
+        res
     } else {
         f64::INFINITY
     }

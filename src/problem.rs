@@ -631,9 +631,12 @@ impl ProblemBuilder {
         let r = self.r.unwrap_or(r_default);
         check_r(r, r_default)?;
         let w = delassus.w();
-        let w_norm = (0..w.nrows())
-            .map(|k| w.col(k).iter().map(|v| v.abs()).sum::<f64>())
-            .fold(0.0f64, f64::max);
+        // (W is symmetric: row k's absolute sum read as its contiguous column k)
+        let w_row_sums: std::sync::Arc<Vec<f64>> = std::sync::Arc::new(
+            (0..w.nrows())
+                .map(|k| w.col(k).iter().map(|v| v.abs()).sum::<f64>())
+                .collect(),
+        );
         Ok(Problem {
             n: n_dofs,
             p,
@@ -646,7 +649,7 @@ impl ProblemBuilder {
             a_scale_log2,
             r,
             r_default,
-            w_norm,
+            w_row_sums,
             delassus,
         })
     }
@@ -1030,8 +1033,8 @@ pub struct Problem {
     a_scale_log2: i32,
     r: f64,
     r_default: f64,
-    /// `‖W‖∞` (equilibrated rows).
-    w_norm: f64,
+    /// The absolute row sums of W (equilibrated rows).
+    w_row_sums: std::sync::Arc<Vec<f64>>,
     delassus: std::sync::Arc<Delassus>,
 }
 
@@ -1110,9 +1113,10 @@ impl Problem {
     pub fn default_r(&self) -> f64 {
         self.r_default
     }
-    /// `‖W‖∞`, the largest absolute row sum of W (equilibrated rows; length per force).
-    pub fn w_norm(&self) -> f64 {
-        self.w_norm
+    /// The absolute row sums of W, `|W| 1` (2p values, equilibrated rows; length per
+    /// force): `(|W| |λ|)_k ≤ (|W| 1)_k ‖λ‖∞` bounds the terms of row k of `W λ`.
+    pub fn w_row_sums(&self) -> &[f64] {
+        &self.w_row_sums
     }
     /// The condensation (Cholesky of A, W).
     pub fn delassus(&self) -> &Delassus {
@@ -1134,7 +1138,7 @@ impl Problem {
             a_scale_log2: self.a_scale_log2,
             r,
             r_default: self.r_default,
-            w_norm: self.w_norm,
+            w_row_sums: self.w_row_sums.clone(),
             delassus: self.delassus.clone(),
         })
     }

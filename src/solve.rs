@@ -33,19 +33,25 @@ fn frozen_class(frozen: Frozen<'_>, i: usize) -> Option<Class> {
     frozen.and_then(|f| f[i])
 }
 
-/// `H2, H3` of the seed (2p values) at `λ`, and the force scale used to make it relative.
-/// Frozen nodes contribute the residuals of their class's equations instead.
+/// `H2, H3` of the seed (2p values) at `λ`, and the force scale of each node (p values)
+/// that makes its two entries relative: the magnitudes of the node's own terms (`λ_i`,
+/// `r d_i`, `r (q − g)_i`, `r (W λ)_i`), but not below a thousandth of the point's force
+/// scale (forces, `r W λ`, and `r q` where the load alone presses or shears). A node far
+/// from the foundation (a large gap) does not set the scale of the others, and a node
+/// with small forces is held to its own. Frozen nodes contribute the residuals of their
+/// class's equations instead.
 fn h_condensed(
     c: &PieceConstants,
     w: MatRef<'_, f64>,
     qg: &[f64],
     lam: &[f64],
     frozen: Frozen<'_>,
-) -> (Vec<f64>, f64) {
+) -> (Vec<f64>, Vec<f64>) {
     let p = c.p;
     let d = displacement_gaps(w, qg, lam);
     let mut h = vec![0.0; 2 * p];
-    let mut scale = 1e-300f64;
+    let mut own = vec![0.0f64; p];
+    let mut global = 1e-300f64;
     for i in 0..p {
         let (ln, lt) = (lam[i], lam[p + i]);
         if let Some(cl) = frozen_class(frozen, i) {
@@ -57,17 +63,29 @@ fn h_condensed(
             let b = (-c.friction[i] * ln).max(0.0);
             h[p + i] = lt - (lt - c.r * d[p + i]).clamp(-b, b);
         }
-        scale = scale
-            .max(ln.abs())
+        let (wl_n, wl_t) = ((d[i] - qg[i]).abs(), (d[p + i] - qg[p + i]).abs());
+        own[i] = ln
+            .abs()
             .max(lt.abs())
             .max(c.r * d[i].abs())
             .max(c.r * d[p + i].abs())
             .max(c.r * qg[i].abs())
-            .max(c.r * qg[p + i].abs());
+            .max(c.r * qg[p + i].abs())
+            .max(c.r * wl_n)
+            .max(c.r * wl_t);
+        global = global
+            .max(ln.abs())
+            .max(lt.abs())
+            .max(c.r * qg[i].max(0.0))
+            .max(c.r * qg[p + i].abs())
+            .max(c.r * wl_n)
+            .max(c.r * wl_t);
     }
-    (h, scale)
+    let scales = own.iter().map(|&s| s.max(1e-3 * global)).collect();
+    (h, scales)
 }
 
+/// `max_i max(|H2_i|, |H3_i|) / scale_i` (see [`h_condensed`]).
 fn rel_residual(
     c: &PieceConstants,
     w: MatRef<'_, f64>,
@@ -76,7 +94,11 @@ fn rel_residual(
     fr: Frozen<'_>,
 ) -> f64 {
     let (h, s) = h_condensed(c, w, qg, lam, fr);
-    h.iter().fold(0.0f64, |m, v| m.max(v.abs())) / s
+    if h.iter().any(|v| !v.is_finite()) {
+        return f64::INFINITY;
+    }
+    let p = c.p;
+    (0..p).fold(0.0f64, |m, i| m.max(h[i].abs().max(h[p + i].abs()) / s[i]))
 }
 
 fn merit(c: &PieceConstants, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Frozen<'_>) -> f64 {

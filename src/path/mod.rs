@@ -250,9 +250,6 @@ pub struct Path {
     /// The last `d = q − (g, 0) + W λ` with its (α, λ): every candidate piece at a
     /// transition point needs it.
     gaps_cache: RefCell<Option<GapsAt>>,
-    /// The absolute row sums of W, `|W| 1` (bounds of the rounding scale of `W λ`), made
-    /// on first use.
-    abs_row_sums: RefCell<Option<Arc<Vec<f64>>>>,
     /// The last point's "at zero" thresholds with its (α, λ).
     tol_cache: RefCell<Option<(f64, Vec<f64>, Tol)>>,
 }
@@ -315,8 +312,6 @@ pub(super) struct TolRows {
     base: Vec<f64>,
     abs_lam: Vec<f64>,
     lam_max: f64,
-    /// `(|W| 1)_k`, for the cheap upper bounds.
-    row_sums: Arc<Vec<f64>>,
     floor: f64,
     /// The thresholds found so far, as f64 bits (NaN: not yet).
     exact: Vec<std::sync::atomic::AtomicU64>,
@@ -343,7 +338,8 @@ impl TolRows {
 
     /// An upper bound of [`Self::exact`] in O(1): `(|W||λ|)_k ≤ (|W| 1)_k ‖λ‖∞`.
     fn upper(&self, k: usize) -> f64 {
-        (self.factor * (self.base[k] + self.row_sums[k] * self.lam_max)).max(self.floor)
+        let row_sum = self.problem.w_row_sums()[k];
+        (self.factor * (self.base[k] + row_sum * self.lam_max)).max(self.floor)
     }
 }
 
@@ -618,7 +614,6 @@ impl Path {
             refactorisations: Cell::new(0),
             row_bound: Cell::new(None),
             gaps_cache: RefCell::new(None),
-            abs_row_sums: RefCell::new(None),
             tol_cache: RefCell::new(None),
         })
     }
@@ -651,18 +646,22 @@ impl Path {
         Ok(Point { lam, alpha, q, dq })
     }
 
-    /// Force scale of a point: `max(‖λ‖∞, r0 ‖q − (g, 0)‖∞, r0 (T + ‖g‖∞))` with T the
+    /// Force scale of a point: `max(‖λ‖∞, r0 T, r0 max_i (q − g)ν_i⁺)` with T the
     /// magnitude of the terms that make up q(α) (see [`Self::term_rows`]): where the load
-    /// passes through zero the rounding of q is still proportional to T. For affine and
-    /// basis loads it depends on the point alone, never on the window.
+    /// passes through zero the rounding of q is still proportional to T. A gap enters only
+    /// where it is negative enough to press (an initial overlap): a node far from the
+    /// foundation does not set the scale of the others. For affine and basis loads it
+    /// depends on the point alone, never on the window.
     fn force_scale(&self, pt: &Point) -> f64 {
         let r0 = self.problem.default_r();
-        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
-        let terms = self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b))
-            + inf_norm(self.problem.gap_equilibrated());
+        let terms = self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b));
+        let overlap =
+            pt.q.iter()
+                .zip(self.problem.gap_equilibrated())
+                .fold(0.0f64, |a, (q, g)| a.max(q - g));
         inf_norm(&pt.lam)
-            .max(r0 * inf_norm(&qg))
             .max(r0 * terms)
+            .max(r0 * overlap)
             .max(1e-300)
     }
 
@@ -701,18 +700,6 @@ impl Path {
         let z = self.opts.zero_tol;
         let r0 = self.problem.default_r();
         let m = pt.lam.len();
-        let row_sums = self
-            .abs_row_sums
-            .borrow_mut()
-            .get_or_insert_with(|| {
-                let w = self.problem.delassus().w();
-                Arc::new(
-                    (0..m)
-                        .map(|k| w.col(k).iter().map(|v| v.abs()).sum())
-                        .collect(),
-                )
-            })
-            .clone();
         let qt = self.term_rows(pt);
         let gap = self.problem.gap_equilibrated();
         let p = self.problem.p();
@@ -725,7 +712,6 @@ impl Path {
             base,
             abs_lam: pt.lam.iter().map(|v| v.abs()).collect(),
             lam_max: inf_norm(&pt.lam),
-            row_sums,
             floor: ROW_FLOOR * z * scale,
             exact: (0..m)
                 .map(|_| std::sync::atomic::AtomicU64::new(f64::NAN.to_bits()))
