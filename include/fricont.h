@@ -1348,7 +1348,8 @@ fricont_status fricont_path_event(const struct fricont_path *path,
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_RANGE` (k),
  * `FRICONT_ERR_LENGTH` (a buffer too short), `FRICONT_ERR_ORDER` (not started),
- * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`. No load callback is called.
+ * `FRICONT_ERR_NUMERICAL` (the state's numbers are not finite), `FRICONT_ERR_POISONED`,
+ * `FRICONT_ERR_PANIC`. No load callback is called.
  *
  * # Safety
  * `path` is NULL or a live handle; `state` is NULL or an initialised struct whose
@@ -1377,7 +1378,8 @@ fricont_status fricont_path_start_state(const struct fricont_path *path,
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_LENGTH`,
  * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK`, `FRICONT_ERR_CALLBACK_VALUE`,
- * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_NUMERICAL` (the state's numbers are not finite), `FRICONT_ERR_POISONED`,
+ * `FRICONT_ERR_PANIC`.
  *
  * # Safety
  * As `fricont_path_event_state`.
@@ -1417,7 +1419,9 @@ fricont_status fricont_path_piece(const struct fricont_path *path,
 
 /**
  * The number of candidate branches at the last transition point (`*count`, not NULL):
- * 0 unless it was a bifurcation.
+ * 0 unless it was a bifurcation. Directly after `fricont_path_start`: the number of
+ * pieces leaving the start point toward alpha_end when more than one does (a
+ * bifurcation at the start, e.g. at a zero-force vertex; the path follows branch 0).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
  * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
@@ -1448,7 +1452,9 @@ fricont_status fricont_path_branch(const struct fricont_path *path,
 /**
  * Continues along candidate branch `k` of the last bifurcation instead of the branch the
  * path took (or after the path stopped with `FRICONT_END_BIFURCATION`); the next
- * `fricont_path_step` follows it. Only directly after the bifurcation step.
+ * `fricont_path_step` follows it. Only directly after the bifurcation step, or directly
+ * after `fricont_path_start` when it offered branches (the path then starts again at
+ * the same point on branch `k`).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (k out of range),
  * `FRICONT_ERR_ORDER` (not started, or no bifurcation pending), `FRICONT_ERR_POISONED`,
@@ -1470,7 +1476,8 @@ fricont_status fricont_path_choose_branch(struct fricont_path *path,
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (α not finite),
  * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK`, `FRICONT_ERR_CALLBACK_VALUE`,
- * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_NUMERICAL` (a piece's solve at α failed), `FRICONT_ERR_POISONED`,
+ * `FRICONT_ERR_PANIC`.
  *
  * # Safety
  * `path` is NULL or a live handle; `count` is NULL or valid for one write.

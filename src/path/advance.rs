@@ -77,7 +77,11 @@ impl Path {
         }
         let (lo, hi) = self.window();
         let ta = cur.t[m];
-        let s_win = if ta > 0.0 {
+        // A vertical piece stays at its α, inside the window (also on its edge): it leaves
+        // through its guards only.
+        let s_win = if cur.scales.is_vertical(&cur.t) {
+            None
+        } else if ta > 0.0 {
             Some((hi - cur.alpha) / ta)
         } else if ta < 0.0 {
             Some((lo - cur.alpha) / ta)
@@ -92,7 +96,11 @@ impl Path {
                 "vertical piece at alpha = {:e} with no exit: the continuum is unbounded",
                 cur.alpha
             ))),
-            (b, Some(sw)) if b.is_none_or(|b| sw <= b.0) => {
+            // A guard that reaches zero where α reaches the window's edge (within zero_tol
+            // along the unit tangent) is a transition point on the edge: the path goes
+            // through it (onto a vertical piece there, or out of the window at once on the
+            // next step).
+            (b, Some(sw)) if b.is_none_or(|b| sw < b.0 - self.opts.zero_tol) => {
                 let alpha = if ta > 0.0 { hi } else { lo };
                 let pt = self.point_at(vec![0.0; m], alpha)?;
                 let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());

@@ -159,8 +159,14 @@ impl Path {
             )));
         }
         let is_vertex: Vec<bool> = options.iter().map(|o| o.len() == 4).collect();
-        let n_vertex = is_vertex.iter().filter(|&&v| v).count();
-        let use_directional = n_vertex > 2;
+        // Every neighbouring piece is examined while they are few enough (this finds every
+        // directional solution at a zero-force vertex, hence every branch); beyond that,
+        // the nodes at the vertex take their classes from the directional problem (one
+        // solution per way along α).
+        let use_directional = options
+            .iter()
+            .fold(1usize, |acc, o| acc.saturating_mul(o.len()))
+            > MAX_CANDIDATE_PIECES;
         let enumerated: Vec<usize> = (0..nodes.len())
             .filter(|&k| !(use_directional && is_vertex[k]))
             .collect();
@@ -321,6 +327,7 @@ impl Path {
             pieces_len,
             last_dir,
             bifurcation,
+            at_start: false,
         };
         {
             let tr = self.trace.as_mut().expect("started");
@@ -495,9 +502,35 @@ impl Path {
         })
     }
 
+    /// Records a bifurcation at the start point: `cands` (the first taken) all leave it
+    /// toward alpha_end.
+    pub(super) fn offer_start_branches(&mut self, pt: Point, cands: Vec<Candidate>) {
+        let m = 2 * self.problem.p();
+        let tr = self.trace.as_mut().expect("started");
+        tr.branches = cands
+            .iter()
+            .map(|c| Branch {
+                classes: c.classes.clone(),
+                direction: sign(c.t[m]),
+                orientation_preserving: true,
+            })
+            .collect();
+        tr.pending = Some(PendingJoin {
+            point: pt,
+            from: cands[0].classes.clone(),
+            cands,
+            events_start: 0,
+            pieces_len: 0,
+            last_dir: tr.last_dir,
+            bifurcation: true,
+            at_start: true,
+        });
+    }
+
     /// Continue along candidate `k` of [`Path::branches`] instead of the one taken (or
     /// after the path stopped with [`EndReason::Bifurcation`]). Only allowed directly after
-    /// the bifurcation step. Errors: not started, no bifurcation pending, `k` out of range.
+    /// the bifurcation step, or directly after [`Path::start`] when it offered branches
+    /// (the path then starts again at the same point on branch `k`). Errors: not started, no bifurcation pending, `k` out of range.
     pub fn choose_branch(&mut self, k: usize) -> Result<()> {
         let tr = self
             .trace
@@ -524,6 +557,16 @@ impl Path {
         }
         if tr.end == Some(EndReason::Bifurcation) {
             tr.end = None;
+        }
+        if pend.at_start {
+            let want = sign(self.opts.alpha_end - self.opts.alpha_start);
+            let branches = std::mem::take(&mut tr.branches);
+            *self.updater.borrow_mut() = None;
+            let res = self.begin(&pend.point, pend.cands[k].clone(), want);
+            let tr = self.trace.as_mut().expect("started");
+            tr.branches = branches;
+            tr.pending = Some(pend);
+            return res;
         }
         let res = self.apply(&pend, k);
         let tr = self.trace.as_mut().expect("started");

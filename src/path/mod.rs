@@ -434,6 +434,8 @@ struct PendingJoin {
     pieces_len: usize,
     last_dir: i8,
     bifurcation: bool,
+    /// The branches leave the start point (no events; choosing one restarts there).
+    at_start: bool,
 }
 
 #[derive(Clone)]
@@ -566,8 +568,9 @@ fn inf_norm(v: &[f64]) -> f64 {
 }
 
 /// Largest number of neighbouring pieces enumerated at one transition point (the product
-/// over the nodes at a class boundary of the number of classes that fit there; nodes at
-/// the vertex are handled by the directional problem instead).
+/// over the nodes at a class boundary of the number of classes that fit there). Beyond it,
+/// nodes at a zero-force vertex are handled by the directional problem (one solution per
+/// way along α), and only the other nodes are enumerated.
 const MAX_CANDIDATE_PIECES: usize = 4096;
 
 impl Path {
@@ -1004,6 +1007,11 @@ impl Path {
 
     /// Starts (or restarts) the path at `alpha` with the fixed-α solver, from `guess`
     /// (`(λν, λt)`, 2p values) or from zero forces. Clears events and pieces.
+    /// When several pieces leave the start point toward `alpha_end`, the path takes the
+    /// first and [`Path::branches`] lists them all (see [`Path::choose_branch`]). When the
+    /// start lies on a vertical piece (a continuum at this α), the path follows the way
+    /// along it that leads toward `alpha_end` (tried by stepping along each; events met on
+    /// the way are the path's own).
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails, the load fails, no piece leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
@@ -1061,17 +1069,60 @@ impl Path {
             cands = self.continuations(&pt, &fixed, &nodes, None, true)?;
         }
         let ms = 2 * p;
-        let pick = cands
-            .iter()
-            .position(|c| sign(c.t[ms]) == want)
-            .or_else(|| cands.iter().position(|c| c.scales.is_vertical(&c.t)));
-        let Some(k) = pick else {
+        let toward: Vec<usize> = (0..cands.len())
+            .filter(|&k| !cands[k].scales.is_vertical(&cands[k].t) && sign(cands[k].t[ms]) == want)
+            .collect();
+        if let Some(&k) = toward.first() {
+            self.begin(&pt, cands[k].clone(), want)?;
+            if toward.len() > 1 {
+                // Several pieces leave the start point toward alpha_end: a bifurcation at
+                // the start. The path takes the first; `branches` lists them all and
+                // `choose_branch` (directly after the start) takes another.
+                let cands: Vec<Candidate> = toward.iter().map(|&k| cands[k].clone()).collect();
+                self.offer_start_branches(pt, cands);
+            }
+            return Ok(());
+        }
+        let verticals: Vec<usize> = (0..cands.len())
+            .filter(|&k| cands[k].scales.is_vertical(&cands[k].t))
+            .collect();
+        let Some(&first) = verticals.first() else {
             return Err(Error::Numerical(format!(
                 "no piece leaves the start point alpha = {alpha} toward alpha_end = {}",
                 self.opts.alpha_end
             )));
         };
-        let cand = cands[k].clone();
+        // The start lies on a vertical piece (a continuum at this α): which way along it
+        // leads toward alpha_end shows only where the path leaves it. Follow each way to
+        // the first piece that moves α, and keep the one that moves it toward alpha_end.
+        for &k in &verticals {
+            *self.updater.borrow_mut() = None;
+            self.begin(&pt, cands[k].clone(), want)?;
+            for _ in 0..16 {
+                match self.step() {
+                    Ok(StepOutcome::Transition { .. }) => {
+                        let cur = &self.trace.as_ref().expect("started").cur;
+                        if !cur.scales.is_vertical(&cur.t) {
+                            if sign(cur.t[ms]) == want {
+                                return Ok(());
+                            }
+                            break;
+                        }
+                    }
+                    Ok(StepOutcome::End(_)) | Err(_) => break,
+                }
+            }
+        }
+        *self.updater.borrow_mut() = None;
+        self.begin(&pt, cands[first].clone(), want)
+    }
+
+    /// Starts the trace at `pt` on candidate `cand` (`want`: the sign of α's way toward
+    /// alpha_end).
+    fn begin(&mut self, pt: &Point, cand: Candidate, want: i8) -> Result<()> {
+        let ms = 2 * self.problem.p();
+        let alpha = pt.alpha;
+        let pt = pt.clone();
         self.commit_solver(&cand.lu);
         let start = self.state(&pt.lam, alpha, &cand.classes)?;
         let dir = if cand.scales.is_vertical(&cand.t) {

@@ -161,7 +161,10 @@ impl Path {
     }
 
     /// Candidate continuations at the last transition point (empty unless it was a
-    /// bifurcation and no step has been taken since).
+    /// bifurcation and no step has been taken since), or, directly after
+    /// [`Path::start`], the pieces leaving the start point toward `alpha_end` when more
+    /// than one does (a bifurcation at the start, for example a zero-force vertex of a
+    /// homogeneous load; the path follows the first, [`Path::choose_branch`] another).
     pub fn branches(&self) -> &[Branch] {
         self.trace
             .as_ref()
