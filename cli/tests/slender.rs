@@ -1,0 +1,238 @@
+//! Slender meshes against an independent tracer (issue 10, failure mode 4: near
+//! transitions merged where the contact forces are small against the load's scale).
+//!
+//! The reference is `tests/common/reference.rs`: its own condensation (envelope Cholesky
+//! with refined solves), a fresh dense LU per piece, exact affine guards, and the generic
+//! transition rules; it shares nothing with fricont's numerics. First it is checked on
+//! problems with known answers (hand-derived ones and brute-force enumeration of every
+//! piece), then fricont's events on generated slender meshes must equal it: same
+//! transitions (node, from, to), α to 1e-8 (relative to max(1, |α|)), the same end of the
+//! window, from the same start.
+
+#[path = "../../tests/common/mod.rs"]
+mod common;
+
+use std::sync::Arc;
+
+use common::reference::{Condensed, Ev, SparseRows, compare_events, compare_with_fricont};
+use common::{Brute, fe_case, fold_problem, mirror_pair, random_case};
+use fricont::Class;
+use fricont_exchange::generator::{RectSpec, generate};
+
+fn no_progress() -> impl FnMut(usize, f64) {
+    |_, _| {}
+}
+
+/// The reference condensation equals the dense, refined one of the brute force.
+#[test]
+fn condensation_matches_dense() {
+    for seed in 0..4 {
+        let case = fe_case(seed, 6, 3, 0.3);
+        let cond = Condensed::from_data(&case.data);
+        let br = Brute::condensed_precise(&case.data);
+        let scale = br.w.amax();
+        let dw = (&cond.w - &br.w).amax();
+        assert!(
+            dw <= 1e-13 * scale,
+            "seed {seed}: |ΔW| = {dw:e} of {scale:e}"
+        );
+        for (a, b) in [(&cond.q0, &br.q0), (&cond.q1, &br.q1)] {
+            let d = (a - b).amax();
+            assert!(d <= 1e-13 * b.amax(), "seed {seed}: |Δq| = {d:e}");
+        }
+    }
+}
+
+/// Reference events as `(α, node, from, to)`.
+fn ref_events(tr: &common::reference::RefTrace) -> Vec<Ev> {
+    tr.events
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect()
+}
+
+/// The reference against brute-force walks (every piece enumerated, joined at shared
+/// end points) on random and finite-element cases small enough to enumerate, folds
+/// included (friction up to 3): same events, fold flags and α to 1e-9.
+#[test]
+fn reference_matches_brute_force_walks() {
+    let mut compared = 0;
+    let mut folds = 0;
+    let mut cases: Vec<common::Case> = (0..40).map(random_case).collect();
+    cases.extend((0..6).map(|s| fe_case(s, 4, 2, if s % 2 == 0 { 0.3 } else { 1.0 })));
+    let total = cases.len();
+    for case in cases {
+        let br = Brute::new(&case.data);
+        // The piece containing the start (unique away from breakpoints).
+        let start: Vec<_> = br
+            .pieces
+            .iter()
+            .filter(|pc| pc.lo < case.a0 && case.a0 < pc.hi)
+            .collect();
+        if start.len() != 1 {
+            continue;
+        }
+        let Some(walk) = br.walk(case.a0, case.a1, &start[0].lambda(case.a0)) else {
+            continue;
+        };
+        if walk.closed {
+            continue;
+        }
+        let cond = Condensed::from_data(&case.data);
+        let tr = cond.trace(
+            &start[0].classes,
+            case.a0,
+            case.a1,
+            1000,
+            &mut no_progress(),
+        );
+        let ctx = format!("seed {} (p = {})", case.seed, case.data.p);
+        assert!(tr.end.is_ok(), "{ctx}: reference stopped: {:?}", tr.end);
+        let want: Vec<Ev> = walk
+            .events
+            .iter()
+            .map(|e| (e.phi, e.node, e.from, e.to))
+            .collect();
+        let d = compare_events(&ref_events(&tr), &want, 1e-9);
+        assert!(d.is_ok(), "{ctx}: {}", d.unwrap_err());
+        let rf: Vec<bool> = tr.events.iter().map(|e| e.fold).collect();
+        let wf: Vec<bool> = walk.events.iter().map(|e| e.fold).collect();
+        assert_eq!(rf, wf, "{ctx}: fold flags");
+        folds += wf.iter().filter(|&&f| f).count();
+        compared += 1;
+    }
+    eprintln!("{compared} of {total} cases compared, {folds} folds");
+    assert!(
+        compared >= total * 3 / 4,
+        "only {compared} of {total} cases had a generic brute-force walk"
+    );
+    assert!(folds >= 3, "only {folds} folds among the walks");
+}
+
+/// Hand-derived answers (`tests/core_hand.rs`): two folds on one node; a symmetric pair
+/// switching together (a degenerate transition: open → slip+ for both at α = 0, slip+ →
+/// stick for both at α = 2).
+#[test]
+fn reference_matches_hand_derivations() {
+    let cond = Condensed::from_data(&fold_problem());
+    let tr = cond.trace(&[Class::Open], -3.0, 3.0, 100, &mut no_progress());
+    assert!(tr.end.is_ok(), "{:?}", tr.end);
+    let want = [
+        (0.0, Class::Open, Class::SlipPlus, true),
+        (-2.0, Class::SlipPlus, Class::Stick, true),
+        (1.2, Class::Stick, Class::SlipMinus, false),
+    ];
+    assert_eq!(tr.events.len(), want.len(), "{:#?}", tr.events);
+    for (e, &(a, from, to, fold)) in tr.events.iter().zip(&want) {
+        assert!((e.alpha - a).abs() <= 1e-14, "{e:?}");
+        assert_eq!((e.node, e.from, e.to, e.fold), (0, from, to, fold));
+    }
+    assert_eq!(tr.end_alpha, 3.0);
+
+    let cond = Condensed::from_data(&mirror_pair());
+    let tr = cond.trace(&[Class::Open; 2], -1.0, 3.0, 100, &mut no_progress());
+    assert!(tr.end.is_ok(), "{:?}", tr.end);
+    let want = [
+        (0.0, 0, Class::Open, Class::SlipPlus),
+        (0.0, 1, Class::Open, Class::SlipPlus),
+        (2.0, 0, Class::SlipPlus, Class::Stick),
+        (2.0, 1, Class::SlipPlus, Class::Stick),
+    ];
+    assert_eq!(tr.events.len(), want.len(), "{:#?}", tr.events);
+    for (e, &(a, node, from, to)) in tr.events.iter().zip(&want) {
+        assert!((e.alpha - a).abs() <= 1e-14, "{e:?}");
+        assert_eq!((e.node, e.from, e.to, e.fold), (node, from, to, false));
+    }
+}
+
+fn condensed(case: &fricont_exchange::io::CaseData) -> Condensed {
+    let p = case.p();
+    Condensed::from_sparse(
+        &SparseRows::from_csr(&case.a),
+        &SparseRows::from_csr(&case.n_mat),
+        &SparseRows::from_csr(&case.t_mat),
+        &case.f0,
+        &case.f1,
+        case.gap.clone().unwrap_or_else(|| vec![0.0; p]),
+        if case.friction.len() == 1 {
+            vec![case.friction[0]; p]
+        } else {
+            case.friction.clone()
+        },
+    )
+}
+
+/// fricont against the reference on a generated rectangle (press-shear load, window
+/// [−0.5, 1.5]).
+fn slender(name: &str, spec: RectSpec) {
+    let case = generate(&spec).expect("generate");
+    let cond = condensed(&case);
+    let problem = Arc::new(case.problem(None).expect("problem"));
+    let c = compare_with_fricont(
+        &cond,
+        problem,
+        &case.f0,
+        &case.f1,
+        case.alpha_start,
+        case.alpha_end,
+        1e-8,
+        &mut no_progress(),
+    );
+    // The reference's own health: accurate piece solves, well separated crossings.
+    let r = &c.reference;
+    assert!(
+        r.max_residual <= 1e-14,
+        "{name}: reference residual {:e}",
+        r.max_residual
+    );
+    if let Err(e) = c.check(1e-8) {
+        panic!(
+            "{name}: fricont {} events, reference {} events: {e}",
+            c.fricont.len(),
+            r.events.len()
+        );
+    }
+    assert!(
+        r.events.len() >= 50,
+        "{name}: only {} events",
+        r.events.len()
+    );
+}
+
+fn beam(friction: f64) -> RectSpec {
+    RectSpec {
+        nx: 121,
+        ny: 2,
+        lx: 48.0,
+        ly: 1.0,
+        friction,
+        ..RectSpec::press_shear()
+    }
+}
+
+#[test]
+fn beam_48_by_1_p120_friction_03() {
+    slender("beam 48 x 1, p = 120, F = 0.3", beam(0.3));
+}
+
+#[test]
+fn beam_48_by_1_p120_friction_1() {
+    slender("beam 48 x 1, p = 120, F = 1", beam(1.0));
+}
+
+/// The thin strip of `cli/benches/strips.rs` with p = 240 (241 × 4 nodes on
+/// (0, 6) × (0, 0.1), aspect ratio 60), the whole window. About 10 s in release: a fresh
+/// double-double-refined LU for each of its 479 pieces.
+#[test]
+fn strip_p240() {
+    slender(
+        "strip p = 240",
+        RectSpec {
+            nx: 241,
+            ny: 4,
+            lx: 6.0,
+            ly: 0.1,
+            ..RectSpec::press_shear()
+        },
+    );
+}
