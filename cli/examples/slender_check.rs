@@ -253,8 +253,8 @@ fn main() {
             c.seconds.1
         );
         println!(
-            "   reference diagnostics: largest piece residual {:.1e}, smallest pivot ratio {:.1e}, closest separate crossings {:.1e}; start λ differ by {:.1e}",
-            r.max_residual, r.min_pivot_ratio, r.min_separation, c.start_diff
+            "   reference diagnostics: largest piece residual {:.1e}, smallest pivot ratio {:.1e}, closest separate crossings {:.1e}, widest group of crossings {:.1e}; start λ differ by {:.1e}",
+            r.max_residual, r.min_pivot_ratio, r.min_separation, r.max_group_spread, c.start_diff
         );
         if let Ok(d) = &c.events {
             println!("   events agree: largest relative α difference {d:.2e}");

@@ -15,7 +15,7 @@ mod common;
 use std::sync::Arc;
 
 use common::reference::{Condensed, Ev, SparseRows, compare_events, compare_with_fricont};
-use common::{Brute, fe_case, fold_problem, mirror_pair, random_case};
+use common::{Brute, fe_case, fold_problem, mirror_pair, random_case, symmetric_case};
 use fricont::Class;
 use fricont_exchange::generator::{RectSpec, generate};
 
@@ -109,6 +109,72 @@ fn reference_matches_brute_force_walks() {
     assert!(folds >= 3, "only {folds} folds among the walks");
 }
 
+/// Degenerate transitions (mirror-symmetric problems: mirrored nodes switch at the same α,
+/// a centre node touches down with dt = 0): at every transition point of the reference,
+/// the piece it continues on is one of the brute force's pieces whose closure contains
+/// the point, and the only one when the brute force has a single continuation; where the
+/// reference stops, the brute force has several continuations (a bifurcation).
+#[test]
+fn reference_degenerate_transitions_match_brute_force() {
+    let (mut degenerate, mut checked, mut stops) = (0, 0, 0);
+    for seed in 0..24 {
+        let case = symmetric_case(seed, seed % 2 == 1);
+        let br = Brute::new(&case.data);
+        let start: Vec<_> = br
+            .pieces
+            .iter()
+            .filter(|pc| pc.lo < case.a0 && case.a0 < pc.hi)
+            .collect();
+        if start.len() != 1 {
+            continue;
+        }
+        let cond = Condensed::from_data(&case.data);
+        let tr = cond.trace(&start[0].classes, case.a0, case.a1, 200, &mut no_progress());
+        let ctx = format!("symmetric seed {seed}");
+        let continuations = |k: usize| {
+            let (cl, _, at) = &tr.pieces[k];
+            let from = br
+                .pieces
+                .iter()
+                .find(|pc| &pc.classes == cl)
+                .unwrap_or_else(|| panic!("{ctx}: piece {cl:?} unknown to the brute force"));
+            let inc = br.incident(*at, &from.lambda(*at), 1e-9);
+            let cont: Vec<Vec<Class>> = inc.iter().filter(|c| *c != cl).cloned().collect();
+            (*at, cont)
+        };
+        for k in 0..tr.pieces.len().saturating_sub(1) {
+            let (at, cont) = continuations(k);
+            let next = &tr.pieces[k + 1].0;
+            assert!(
+                cont.contains(next),
+                "{ctx}: at α = {at} the reference took {next:?}, the brute force offers {cont:?}"
+            );
+            if cont.len() == 1 {
+                checked += 1;
+            }
+            let switched = (0..next.len())
+                .filter(|&i| next[i] != tr.pieces[k].0[i])
+                .count();
+            degenerate += (switched > 1) as usize;
+        }
+        if let Err(e) = &tr.end {
+            let (at, cont) = continuations(tr.pieces.len() - 1);
+            assert!(
+                cont.len() > 1,
+                "{ctx}: the reference stopped at α = {at} ({e}) where the brute force continues by {cont:?}"
+            );
+            stops += 1;
+        }
+    }
+    eprintln!(
+        "{checked} unique continuations checked, {degenerate} degenerate, {stops} stops at bifurcations"
+    );
+    assert!(
+        degenerate >= 10 && checked >= 40,
+        "too few transitions checked"
+    );
+}
+
 /// Hand-derived answers (`tests/core_hand.rs`): two folds on one node; a symmetric pair
 /// switching together (a degenerate transition: open → slip+ for both at α = 0, slip+ →
 /// stick for both at α = 2).
@@ -178,12 +244,18 @@ fn slender(name: &str, spec: RectSpec) {
         1e-8,
         &mut no_progress(),
     );
-    // The reference's own health: accurate piece solves, well separated crossings.
+    // The reference's own health: accurate piece solves, no crossings grouped into one
+    // transition that were not simultaneous.
     let r = &c.reference;
     assert!(
-        r.max_residual <= 1e-14,
+        r.max_residual <= 1e-20,
         "{name}: reference residual {:e}",
         r.max_residual
+    );
+    assert!(
+        r.max_group_spread <= 1e-12,
+        "{name}: the reference grouped crossings {:e} apart",
+        r.max_group_spread
     );
     if let Err(e) = c.check(1e-8) {
         panic!(

@@ -28,9 +28,9 @@
 //!   (open → slip± by the sign of dt, stick → slip± by the cone side reached, slip → stick,
 //!   slip → open); the new piece must contain the point (its λ at α* equals the old one)
 //!   and enter its region (every guard of a switched node that is at zero there increases
-//!   along the new direction, every other guard non-negative). If the generic choice fails,
-//!   every other class combination of the switched nodes is tried; if not exactly one
-//!   fits, tracing stops and says why. The direction of α on a piece follows the
+//!   along the new direction, every other guard non-negative). When several nodes switch
+//!   at once, or the generic choice does not fit, every class combination of the switched
+//!   nodes is tried; if not exactly one fits, tracing stops and says why. The direction of α on a piece follows the
 //!   orientation rule of SPEC §4: `sign(dα/ds) = orientation · sign det K`, the orientation
 //!   fixed at the start; a sign change is a fold. A singular piece (vertical) stops the
 //!   trace. The trace ends when α leaves the window.
@@ -873,6 +873,9 @@ pub struct RefTrace {
     /// The smallest relative distance in α between the transition taken and the next
     /// crossing not grouped with it (how close the nearest separate crossings came).
     pub min_separation: f64,
+    /// The largest relative distance in α between crossings grouped into one transition
+    /// (0 when every transition had one crossing or exactly simultaneous ones).
+    pub max_group_spread: f64,
 }
 
 /// Crossings within this relative α of the nearest are one transition.
@@ -925,8 +928,8 @@ impl Condensed {
     /// Checks that `cand` continues the path at `alpha` from the piece `old` after the
     /// nodes in `group` switched: it contains the point and enters its region
     /// with direction `dir`. A guard of a switched node that is zero by construction
-    /// ([`structural_zero`]) must increase along `dir`; every guard must be non-negative
-    /// to 1e-9 of the magnitude it is computed from.
+    /// ([`structural_zero`]) or within 1e-12 of the magnitude of `g0` and `α g1` must
+    /// increase along `dir`; every guard must be non-negative to that accuracy.
     fn enters(
         &self,
         cand: &RefPiece,
@@ -954,15 +957,16 @@ impl Condensed {
         }
         for g in &cand.guards {
             let v = g.at(alpha);
-            let thr = 1e-9 * g.scale.max(g.g0.abs()).max((alpha * g.g1).abs());
+            // v is rounded from g0 + α g1 (coefficients accurate to a unit in the last
+            // place); the scale of the terms λ or d are made of enters only through λ,
+            // accurate to double-double.
+            let thr = 1e-12 * g.g0.abs().max((alpha * g.g1).abs()) + 1e-20 * g.scale;
             if v < -thr {
                 return Err(format!("node {} guard {:?} = {v:e} < 0", g.node, g.kind));
             }
             let i = g.node;
-            if group.contains(&i)
-                && structural_zero(old.classes[i], cand.classes[i], g.kind)
-                && dir * g.g1 <= 0.0
-            {
+            let at_zero = structural_zero(old.classes[i], cand.classes[i], g.kind) || v <= thr;
+            if group.contains(&i) && at_zero && dir * g.g1 <= 0.0 {
                 return Err(format!(
                     "node {i} guard {:?} at zero does not increase (slope {:e})",
                     g.kind,
@@ -993,6 +997,7 @@ impl Condensed {
             max_residual: 0.0,
             min_pivot_ratio: 1.0,
             min_separation: f64::INFINITY,
+            max_group_spread: 0.0,
         };
         let mut piece = match self.piece(classes0, a0) {
             Ok(pc) => pc,
@@ -1054,6 +1059,11 @@ impl Condensed {
                 .take_while(|c| c.0 <= t0.max(0.0) + gtol)
                 .map(|c| c.2)
                 .collect();
+            if let Some(last) = cross.get(group_guards.len() - 1) {
+                out.max_group_spread = out
+                    .max_group_spread
+                    .max((last.0 - t0) / 1f64.max(a_e.abs()));
+            }
             if let Some(next) = cross.get(group_guards.len()) {
                 out.min_separation = out.min_separation.min((next.0 - t0) / 1f64.max(a_e.abs()));
             }
@@ -1090,7 +1100,15 @@ impl Condensed {
                 self.enters(&pc, &piece, a_e, &nodes, d)?;
                 Ok((pc, d))
             };
-            let chosen = match try_piece(&generic) {
+            // One node: the generic rule, if its piece fits. Several nodes at once (a
+            // degenerate transition), or a generic piece that does not fit: every
+            // combination, and exactly one must fit.
+            let first = if nodes.len() == 1 {
+                try_piece(&generic)
+            } else {
+                Err("several nodes".to_string())
+            };
+            let chosen = match first {
                 Ok(x) => Ok(x),
                 Err(why_generic) => {
                     // Every other combination of classes of the switched nodes.
@@ -1102,7 +1120,7 @@ impl Condensed {
                         for (b, &i) in nodes.iter().enumerate() {
                             cl[i] = Class::ALL[(code >> (2 * b)) & 3];
                         }
-                        if cl == piece.classes || cl == generic {
+                        if cl == piece.classes || (nodes.len() == 1 && cl == generic) {
                             continue;
                         }
                         match try_piece(&cl) {
@@ -1418,6 +1436,7 @@ pub fn compare_with_fricont(
                 max_residual: 0.0,
                 min_pivot_ratio: 0.0,
                 min_separation: f64::INFINITY,
+                max_group_spread: 0.0,
             },
         ),
     };
