@@ -294,6 +294,25 @@ fn main() {
                 );
             }
         }
+        // The neighbourhood of the largest difference, in both traces.
+        if let Some(&(k, _, _)) = diffs.first() {
+            let (lo, hi) = (k.saturating_sub(2), (k + 3).min(want.len()));
+            let (a, b) = (
+                want[lo].0.min(want[hi - 1].0),
+                want[lo].0.max(want[hi - 1].0),
+            );
+            let show = |e: &Ev| format!("α = {:.14e} node {:>4} {} -> {}", e.0, e.1 + 1, e.2, e.3);
+            println!("   around reference event {}:", k + 1);
+            for (j, e) in want.iter().enumerate().take(hi).skip(lo) {
+                println!("     reference {:>4}: {}", j + 1, show(e));
+            }
+            let pad = 1e-6 * 1f64.max(a.abs());
+            for (j, e) in c.fricont.iter().enumerate() {
+                if e.0 >= a - pad && e.0 <= b + pad {
+                    println!("     fricont   {:>4}: {}", j + 1, show(e));
+                }
+            }
+        }
         if std::env::var_os("SLENDER_TRACER_ONLY").is_some() {
             tracer_only(&case, &cond, &c.fricont);
         }
