@@ -13,6 +13,8 @@ use fricont::path::State;
 use fricont::{Class, CsrMatrix, Load, Path, PathOptions, Problem, ProblemBuilder, Storage};
 use nalgebra::{DMatrix, DVector};
 
+pub mod reference;
+
 // ---------------------------------------------------------------------------------------
 // Random numbers: xorshift64* with a fixed seed (no dependency).
 // ---------------------------------------------------------------------------------------
