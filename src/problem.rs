@@ -51,11 +51,10 @@ impl CsrMatrix {
                 "{name} (CSR): index_base is {index_base}, must be 0 or 1"
             )));
         }
-        if row_ptr.len() != nrows + 1 {
+        if nrows.checked_add(1) != Some(row_ptr.len()) {
             return Err(Error::Csr(format!(
-                "{name} (CSR): row_ptr has {} entries, expected nrows + 1 = {}",
+                "{name} (CSR): row_ptr has {} entries, expected nrows + 1 = {nrows} + 1",
                 row_ptr.len(),
-                nrows + 1
             )));
         }
         if col_idx.len() != values.len() {
@@ -72,7 +71,7 @@ impl CsrMatrix {
             )));
         }
         let nnz = values.len();
-        let mut rp = try_with_capacity(nrows + 1, &format!("{name}: row pointers"))?;
+        let mut rp = try_with_capacity(row_ptr.len(), &format!("{name}: row pointers"))?;
         let mut prev = first;
         for (i, r) in row_ptr.iter().enumerate() {
             let r: i64 = (*r).into();
@@ -193,7 +192,10 @@ impl CsrMatrix {
             }
         }
         t.sort_by_key(|e| (e.0, e.1));
-        let mut row_ptr = crate::error::try_vec(nrows + 1, 0usize, name)?;
+        let len = nrows
+            .checked_add(1)
+            .ok_or_else(|| Error::Dimension(format!("{name}: {nrows} rows is too many")))?;
+        let mut row_ptr = crate::error::try_vec(len, 0usize, name)?;
         let mut col_idx = try_with_capacity(t.len(), &format!("{name}: column indices"))?;
         let mut values: Vec<f64> = try_with_capacity(t.len(), &format!("{name}: values"))?;
         let mut last: Option<(usize, usize)> = None;
@@ -231,7 +233,7 @@ impl CsrMatrix {
     /// Builds a CSR matrix from a dense row-major array, dropping exact zeros
     /// (convenient for tests and tiny problems).
     pub fn from_dense(nrows: usize, ncols: usize, row_major: &[f64]) -> Result<Self> {
-        if row_major.len() != nrows * ncols {
+        if nrows.checked_mul(ncols) != Some(row_major.len()) {
             return Err(Error::Dimension(format!(
                 "dense array has {} entries, expected {nrows}x{ncols}",
                 row_major.len()
@@ -722,7 +724,14 @@ pub(crate) fn mul_pow2(mut x: f64, mut e: i32) -> f64 {
 /// node's scale. Returns `B = [N; T] / s` (2p×n) and the scales.
 fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMatrix, Vec<f64>)> {
     let p = n.nrows();
-    let row_norm = |m: &CsrMatrix, i: usize| m.row(i).map(|(_, v)| v * v).sum::<f64>().sqrt();
+    // ‖row‖₂ without overflow or underflow: scaled by the row's largest entry.
+    let row_norm = |m: &CsrMatrix, i: usize| {
+        let big = m.row(i).fold(0.0f64, |a, (_, v)| a.max(v.abs()));
+        if big == 0.0 {
+            return 0.0;
+        }
+        big * m.row(i).map(|(_, v)| (v / big) * (v / big)).sum::<f64>().sqrt()
+    };
     let node_scale: Vec<f64> = (0..p)
         .map(|i| {
             let s = row_norm(n, i).max(row_norm(t, i));

@@ -727,7 +727,20 @@ fn csr_extreme_indices_are_errors_not_overflows() {
         // a first row pointer of i64::MAX
         let e = CsrMatrix::from_raw("M", 1, 2, &[i64::MAX, i64::MAX], &[], &[], base);
         assert!(matches!(e, Err(Error::Csr(_))), "base {base}: {e:?}");
+        // a row count of usize::MAX (nrows + 1 overflows)
+        let e = no_panic("from_raw with usize::MAX rows", || {
+            CsrMatrix::from_raw("M", usize::MAX, 2, &[base], &[], &[], base)
+        });
+        assert!(matches!(e, Err(Error::Csr(_))), "base {base}: {e:?}");
     }
+    let e = no_panic("from_triplets with usize::MAX rows", || {
+        CsrMatrix::from_triplets("M", usize::MAX, 2, &[])
+    });
+    assert!(e.is_err(), "{e:?}");
+    let e = no_panic("from_dense with usize::MAX x 2", || {
+        CsrMatrix::from_dense(usize::MAX, 2, &[])
+    });
+    assert!(matches!(e, Err(Error::Dimension(_))), "{e:?}");
 }
 
 /// Duplicate entries in CSR input are summed, in the order given, with 64-bit and

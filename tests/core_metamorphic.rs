@@ -315,3 +315,29 @@ fn a_node_far_from_the_foundation_changes_nothing_else() {
     }
     assert!(checked >= 8, "only {checked} cases with events");
 }
+
+/// Per-node scaling beyond the square root of the floating-point range: node rows of
+/// size 1e±160 (their squares over- or underflow) are equilibrated like any other
+/// (the node's row norm is taken without squaring its entries): the same events as the
+/// unscaled problem.
+#[test]
+fn per_node_row_scalings_at_extreme_sizes() {
+    for seed in 0..20u64 {
+        let case = random_case(seed);
+        let data = &case.data;
+        let mut q = data.clone();
+        let c: Vec<f64> = (0..data.p)
+            .map(|i| if (i + seed as usize) % 2 == 0 { 1e160 } else { 1e-160 })
+            .collect();
+        for (i, &ci) in c.iter().enumerate() {
+            q.nm.row_mut(i).scale_mut(ci);
+            q.tm.row_mut(i).scale_mut(ci);
+            q.gap[i] *= ci;
+        }
+        let base = run(data, case.a0, case.a1);
+        let path = run(&q, case.a0, case.a1);
+        let ctx = format!("seed {seed}, factors {c:?}");
+        assert_eq!(base.events().len(), path.events().len(), "{ctx}");
+        assert_prefix(&ctx, base.events(), path.events(), 1e-10);
+    }
+}
