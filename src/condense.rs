@@ -549,7 +549,8 @@ impl Delassus {
         &self,
         mut y: MatMut<'_, f64>,
         lam: MatRef<'_, f64>,
-    ) -> Result<Mat<f64>> {
+        mut u: MatMut<'_, f64>,
+    ) -> Result<()> {
         let (llt, fwd) = self.supernodal()?;
         let z = self.z.as_ref().expect("supernodal() checked z");
         let (n, k) = (self.n, y.ncols());
@@ -564,14 +565,20 @@ impl Delassus {
         );
         let mut mem = self.solve_scratch(k)?;
         llt.l_transpose_solve_with_conj(Conj::No, y.as_mut(), Par::Seq, MemStack::new(&mut mem));
-        let mut u = try_zeros(n, k, "the displacements u")?;
         for c in 0..k {
+            let yc = y.as_ref().col(c);
+            let mut uc = u.as_mut().col_mut(c);
             for (i, &j) in fwd.iter().enumerate() {
-                u[(j, c)] = self.h * y[(i, c)];
+                uc[j] = self.h * yc[i];
             }
-            check_u(&u.col(c).iter().copied().collect::<Vec<_>>())?;
+            check_u(
+                uc.as_ref()
+                    .try_as_col_major()
+                    .expect("contiguous")
+                    .as_slice(),
+            )?;
         }
-        Ok(u)
+        Ok(())
     }
 
     fn supernodal(&self) -> Result<(SupernodalLltRef<'_, usize, f64>, &[usize])> {

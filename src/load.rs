@@ -287,50 +287,58 @@ impl BoundLoad {
         })
     }
 
-    /// `f(α)` from a snapshot taken at the same α (no closure is called).
-    pub(crate) fn force_from(&self, alpha: f64, snap: &LoadSnapshot) -> Vec<f64> {
+    /// `f(α)` into `out` (n entries) from a snapshot taken at the same α (no closure is
+    /// called).
+    pub(crate) fn force_into(&self, alpha: f64, snap: &LoadSnapshot, out: &mut [f64]) {
         match (&self.load, snap) {
-            (Load::Affine { f0, f1 }, _) => f0
-                .iter()
-                .zip(f1.iter())
-                .map(|(a, b)| a + alpha * b)
-                .collect(),
+            (Load::Affine { f0, f1 }, _) => {
+                for ((o, a), b) in out.iter_mut().zip(f0.iter()).zip(f1.iter()) {
+                    *o = a + alpha * b;
+                }
+            }
             (Load::Basis { vectors, .. }, LoadSnapshot::Weights(w)) => {
-                let mut f = vec![0.0; vectors[0].len()];
+                out.fill(0.0);
                 for (wj, v) in w.iter().zip(vectors) {
-                    for (fi, vi) in f.iter_mut().zip(v) {
+                    for (fi, vi) in out.iter_mut().zip(v) {
                         *fi += wj * vi;
                     }
                 }
-                f
             }
-            (_, LoadSnapshot::Force(f)) => f.clone(),
+            (_, LoadSnapshot::Force(f)) => out.copy_from_slice(f),
             (_, _) => unreachable!("a snapshot always matches its load"),
         }
     }
 
-    /// True when [`Self::half_solved_from`] answers (an affine or basis load on a problem
+    /// True when [`Self::half_solved_into`] answers (an affine or basis load on a problem
     /// with half solves).
     pub(crate) fn has_half(&self) -> bool {
         self.half.is_some()
     }
 
-    /// `L⁻¹ Pᵀ f(α)` for an affine or basis load whose vectors were half-solved (see
-    /// [`Delassus::half_solve`]); `None` otherwise (a general load: half-solve `f` itself).
-    pub(crate) fn half_solved_from(&self, alpha: f64, snap: &LoadSnapshot) -> Option<Vec<f64>> {
-        let y = self.half.as_ref()?;
+    /// `L⁻¹ Pᵀ f(α)` into `out` (n entries) for an affine or basis load whose vectors were
+    /// half-solved (see [`Delassus::half_solve`]); false (nothing written) otherwise (a
+    /// general load: half-solve `f` itself).
+    pub(crate) fn half_solved_into(
+        &self,
+        alpha: f64,
+        snap: &LoadSnapshot,
+        out: &mut [f64],
+    ) -> bool {
+        let Some(y) = self.half.as_ref() else {
+            return false;
+        };
         let w: Vec<f64> = match (&self.load, snap) {
             (Load::Affine { .. }, _) => vec![1.0, alpha],
             (Load::Basis { .. }, LoadSnapshot::Weights(w)) => w.clone(),
-            _ => return None,
+            _ => return false,
         };
-        let mut out = vec![0.0; y.nrows()];
+        out.fill(0.0);
         for (c, wc) in w.iter().enumerate() {
             for (o, v) in out.iter_mut().zip(y.col(c).iter()) {
                 *o += wc * v;
             }
         }
-        Some(out)
+        true
     }
 
     /// The load vector `f(α)` (n entries).

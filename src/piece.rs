@@ -508,33 +508,175 @@ pub(crate) fn orientation(j: MatRef<'_, f64>, t: &[f64]) -> i8 {
 /// solve `B u` comes from its u; for condensed input (u empty, `f` the condensed load q)
 /// `B u = q + W λ`, with `|q| + |W||λ|` as its terms' magnitude.
 pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
-    let (n, p, r) = (problem.n(), problem.p(), problem.r());
+    residuals(problem, &[(u, lam, f)], &mut Vec::new())[0]
+}
+
+/// [`residual`] of several points `(u, λ, f)` at once (all with u, or all without): one
+/// pass over A for all of them, which on large meshes costs little more than one.
+/// `scratch` is working memory (n × the number of points), kept by the caller between
+/// calls.
+pub fn residuals(
+    problem: &Problem,
+    points: &[(&[f64], &[f64], &[f64])],
+    scratch: &mut Vec<f64>,
+) -> Vec<f64> {
+    let n = problem.n();
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    if !(finite(u) && finite(lam) && finite(f)) {
-        return f64::INFINITY;
-    }
-    // Terms near the end of the range of doubles (a load of 1e308, u of 1e308) would
-    // overflow in the sums below: u, f, λ and g are multiplied by a power of two σ first,
-    // which does not change H / scale (H is homogeneous of degree one in them).
     let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let big = inf(u)
-        .max(inf(f))
-        .max(inf(lam))
-        .max(inf(problem.gap_equilibrated()));
-    let sigma_log2 = if big > 0.0 && !(2f64.powi(-500)..=2f64.powi(500)).contains(&big) {
-        -(big.log2().ceil() as i32)
-    } else {
-        0
+    // Terms near the end of the range of doubles (a load of 1e308, u of 1e308) would
+    // overflow in the sums below: u, f, λ and g of each point are multiplied by a power of
+    // two σ first, which does not change H / scale (H is homogeneous of degree one in
+    // them).
+    let sigmas: Vec<i32> = points
+        .iter()
+        .map(|(u, lam, f)| {
+            let big = inf(u)
+                .max(inf(f))
+                .max(inf(lam))
+                .max(inf(problem.gap_equilibrated()));
+            if big > 0.0 && !(2f64.powi(-500)..=2f64.powi(500)).contains(&big) {
+                -(big.log2().ceil() as i32)
+            } else {
+                0
+            }
+        })
+        .collect();
+    let scaled = |v: &[f64], k: i32| -> Vec<f64> {
+        v.iter().map(|&x| crate::problem::mul_pow2(x, k)).collect()
     };
-    let sigma = |v: &[f64]| -> Vec<f64> {
-        v.iter()
-            .map(|&x| crate::problem::mul_pow2(x, sigma_log2))
-            .collect()
-    };
-    let (u, lam, f) = (&sigma(u)[..], &sigma(lam)[..], &sigma(f)[..]);
-    let gap = sigma(problem.gap_equilibrated());
-    let mut h = 0.0f64;
-    let mut scale = 1e-300f64;
+    let ok: Vec<bool> = points
+        .iter()
+        .map(|(u, lam, f)| finite(u) && finite(lam) && finite(f))
+        .collect();
+    // H1 of every point with one pass over A: (|H1|∞, scale) per point.
+    let mut h1 = vec![(0.0f64, 1e-300f64); points.len()];
+    if let Some(a) = problem.a()
+        && points.iter().all(|(u, _, _)| u.len() == n)
+    {
+        // H1 of the problem as factorised, 2^(k/2) (A u − f − Bᵀ λ) with A scaled by 2^k
+        // (k = a_scale_log2, 0 for ordinary data): every product below is between
+        // numbers of the range that was factorised (exact scalings by powers of two).
+        let hs = crate::problem::mul_pow2(1.0, problem.a_scale_log2() / 2);
+        let k = points.len();
+        // u of all points interleaved (row j holds u_c[j] for every point c), so that the
+        // pass over A reads each point's entries next to each other.
+        // Both in tiles of rows, so that the point-by-point reads and writes stay in cache.
+        const TILE: usize = 64;
+        scratch.resize(n * k, 0.0);
+        let ut = &mut scratch[..n * k];
+        for jb in (0..n).step_by(TILE) {
+            let je = (jb + TILE).min(n);
+            for (c, &(u, _, _)) in points.iter().enumerate() {
+                for j in jb..je {
+                    ut[j * k + c] = crate::problem::mul_pow2(u[j], sigmas[c]) / hs;
+                }
+            }
+        }
+        let lams: Vec<Vec<f64>> = points
+            .iter()
+            .zip(&sigmas)
+            .map(|((_, lam, _), &sg)| scaled(lam, sg))
+            .collect();
+        let bt = problem.b().transpose();
+        let mut au = vec![0.0; TILE * k];
+        let mut au_abs = vec![0.0; TILE * k];
+        for ib in (0..n).step_by(TILE) {
+            let ie = (ib + TILE).min(n);
+            faer::traits::pulp::Arch::new().dispatch(TileProducts {
+                a,
+                rows: ib..ie,
+                ut,
+                k,
+                au: &mut au,
+                au_abs: &mut au_abs,
+            });
+            for (c, &(_, _, f)) in points.iter().enumerate() {
+                let (h, sc) = &mut h1[c];
+                for i in ib..ie {
+                    let (mut btl, mut btl_abs) = (0.0, 0.0);
+                    for (l, v) in bt.row(i) {
+                        let x = hs * v * lams[c][l];
+                        btl += x;
+                        btl_abs += x.abs();
+                    }
+                    let fi = hs * crate::problem::mul_pow2(f[i], sigmas[c]);
+                    let t = (i - ib) * k + c;
+                    *h = h.max((au[t] - fi - btl).abs());
+                    *sc = sc.max(au_abs[t]).max(fi.abs()).max(btl_abs);
+                }
+            }
+        }
+    }
+    points
+        .iter()
+        .enumerate()
+        .map(|(c, &(u, lam, f))| {
+            if !ok[c] {
+                return f64::INFINITY;
+            }
+            let sg = sigmas[c];
+            let scaled_copies;
+            let (u, lam, f) = if sg == 0 {
+                (u, lam, f)
+            } else {
+                scaled_copies = [scaled(u, sg), scaled(lam, sg), scaled(f, sg)];
+                let [u, lam, f] = &scaled_copies;
+                (&u[..], &lam[..], &f[..])
+            };
+            let gap = scaled(problem.gap_equilibrated(), sg);
+            node_residual(problem, u, lam, f, &gap, h1[c])
+        })
+        .collect()
+}
+
+/// `A u` and `|A||u|` of rows `rows` for k interleaved points (`ut`, row j holding the
+/// points' u_j), into `au`, `au_abs` (k per row, from the first row of `rows`): the hot
+/// loop of [`residuals`], compiled for the machine's vector instructions by the dispatch.
+struct TileProducts<'a> {
+    a: &'a crate::problem::CsrMatrix,
+    rows: std::ops::Range<usize>,
+    ut: &'a [f64],
+    k: usize,
+    au: &'a mut [f64],
+    au_abs: &'a mut [f64],
+}
+
+impl faer::traits::pulp::WithSimd for TileProducts<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) {
+        let k = self.k;
+        self.au.fill(0.0);
+        self.au_abs.fill(0.0);
+        let first = self.rows.start;
+        for i in self.rows {
+            let t = (i - first) * k;
+            let (s, sa) = (&mut self.au[t..t + k], &mut self.au_abs[t..t + k]);
+            for (j, v) in self.a.row(i) {
+                let row = &self.ut[j * k..(j + 1) * k];
+                for ((s, sa), &x) in s.iter_mut().zip(sa.iter_mut()).zip(row) {
+                    let x = v * x;
+                    *s += x;
+                    *sa += x.abs();
+                }
+            }
+        }
+    }
+}
+
+/// The residual of one point (scaled by its σ) from its H1 part `(|H1|∞, scale)`: H2, H3
+/// node by node (see [`residual`]).
+fn node_residual(
+    problem: &Problem,
+    u: &[f64],
+    lam: &[f64],
+    f: &[f64],
+    gap: &[f64],
+    (h, scale): (f64, f64),
+) -> f64 {
+    let (p, r) = (problem.p(), problem.r());
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
     let mut bu = vec![0.0; 2 * p];
     let mut bu_abs = vec![0.0; 2 * p];
     if u.is_empty() {
@@ -559,31 +701,6 @@ pub fn residual(problem: &Problem, u: &[f64], lam: &[f64], f: &[f64]) -> f64 {
                 bu[i] += v * u[j];
                 bu_abs[i] += (v * u[j]).abs();
             }
-        }
-    }
-    if let Some(a) = problem.a() {
-        // H1 of the problem as factorised, 2^(k/2) (A u − f − Bᵀ λ) with A scaled by 2^k
-        // (k = a_scale_log2, 0 for ordinary data): every product below is between
-        // numbers of the range that was factorised (exact scalings by powers of two).
-        let hs = crate::problem::mul_pow2(1.0, problem.a_scale_log2() / 2);
-        let u_s: Vec<f64> = u.iter().map(|v| v / hs).collect();
-        let mut btl = vec![0.0; n];
-        let mut btl_abs = vec![0.0; n];
-        for (i, &l) in lam.iter().enumerate() {
-            for (j, v) in problem.b().row(i) {
-                btl[j] += hs * v * l;
-                btl_abs[j] += (hs * v * l).abs();
-            }
-        }
-        for i in 0..n {
-            let (mut au, mut au_abs) = (0.0, 0.0);
-            for (j, v) in a.row(i) {
-                au += v * u_s[j];
-                au_abs += (v * u_s[j]).abs();
-            }
-            let fi = hs * f[i];
-            h = h.max((au - fi - btl[i]).abs());
-            scale = scale.max(au_abs).max(fi.abs()).max(btl_abs[i]);
         }
     }
     // H1 relative to its own terms; H2, H3 node by node, relative to the node's terms,

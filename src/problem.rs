@@ -724,13 +724,22 @@ pub(crate) fn mul_pow2(mut x: f64, mut e: i32) -> f64 {
 /// node's scale. Returns `B = [N; T] / s` (2p×n) and the scales.
 fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMatrix, Vec<f64>)> {
     let p = n.nrows();
-    // ‖row‖₂ without overflow or underflow: scaled by the row's largest entry.
+    // ‖row‖₂, scaled by the row's largest entry where the sum of squares would overflow or
+    // lose accuracy to underflow.
     let row_norm = |m: &CsrMatrix, i: usize| {
+        let s2 = m.row(i).map(|(_, v)| v * v).sum::<f64>();
+        if s2.is_normal() && s2 < f64::MAX {
+            return s2.sqrt();
+        }
         let big = m.row(i).fold(0.0f64, |a, (_, v)| a.max(v.abs()));
         if big == 0.0 {
             return 0.0;
         }
-        big * m.row(i).map(|(_, v)| (v / big) * (v / big)).sum::<f64>().sqrt()
+        big * m
+            .row(i)
+            .map(|(_, v)| (v / big) * (v / big))
+            .sum::<f64>()
+            .sqrt()
     };
     let node_scale: Vec<f64> = (0..p)
         .map(|i| {

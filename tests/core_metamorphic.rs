@@ -327,7 +327,13 @@ fn per_node_row_scalings_at_extreme_sizes() {
         let data = &case.data;
         let mut q = data.clone();
         let c: Vec<f64> = (0..data.p)
-            .map(|i| if (i + seed as usize) % 2 == 0 { 1e160 } else { 1e-160 })
+            .map(|i| {
+                if (i + seed as usize).is_multiple_of(2) {
+                    1e160
+                } else {
+                    1e-160
+                }
+            })
             .collect();
         for (i, &ci) in c.iter().enumerate() {
             q.nm.row_mut(i).scale_mut(ci);

@@ -582,11 +582,14 @@ pub fn run(opts: &CaseStudyOptions) -> Result<CaseStudyReport> {
         &marked_points(&tr.path),
         &event_nodes(&tr.path),
         &format!(
-            "The traced path, α from {} to {} (F = {}): {} transition points",
+            "The traced path, α from {} to {} (F = {}): {}",
             spec.alpha_start,
             spec.alpha_end,
             spec.friction,
-            rows.last().map_or(0, |r| r.transition)
+            fricont_exchange::report::plural(
+                rows.last().map_or(0, |r| r.transition),
+                "transition point"
+            )
         ),
         &svg,
     )?;

@@ -260,16 +260,8 @@ impl PathReport {
             lambda_t: s.lambda_t.clone(),
         });
         let list: Vec<Event> = path.events().to_vec();
-        // Residuals only; states in blocks so that no more than a block of u is held.
-        let residuals: Option<Vec<f64>> = (0..list.len())
-            .step_by(64)
-            .map(|a| {
-                path.event_states(a..(a + 64).min(list.len()))
-                    .map(|v| v.into_iter().map(|s| s.residual).collect::<Vec<f64>>())
-            })
-            .collect::<fricont::Result<Vec<_>>>()
-            .ok()
-            .map(|v| v.concat());
+        // Residuals only (no u is kept).
+        let residuals: Option<Vec<f64>> = path.event_residuals(0..list.len()).ok();
         let mut events: Vec<EventReport> = Vec::with_capacity(list.len());
         for e in &list {
             events.push(EventReport {

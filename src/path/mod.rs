@@ -780,6 +780,18 @@ impl Path {
         u: Vec<f64>,
     ) -> State {
         let residual = crate::piece::residual(&self.problem, &u, lam, f);
+        self.state_with(lam, alpha, classes, u, residual)
+    }
+
+    /// A state from its parts (λ internal; `residual` computed by the caller).
+    fn state_with(
+        &self,
+        lam: &[f64],
+        alpha: f64,
+        classes: &[Class],
+        u: Vec<f64>,
+        residual: f64,
+    ) -> State {
         let p = self.problem.p();
         let user = self.lam_to_user(lam);
         State {

@@ -51,6 +51,35 @@ impl Path {
     /// transition share it). Errors: not started, the range exceeds the events.
     pub fn event_states(&self, range: std::ops::Range<usize>) -> Result<Vec<State>> {
         let tr = self.trace_ref()?;
+        let mut states = Vec::with_capacity(range.len());
+        self.event_points(range.clone(), |k, u, residual| {
+            let e = &tr.events[k];
+            let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
+            let lam = self.lam_to_internal(&lam);
+            states.push(self.state_with(&lam, e.alpha, &e.classes, u.to_vec(), residual));
+        })?;
+        Ok(states)
+    }
+
+    /// The residuals of the states at events `range` (as in [`Path::event_states`], whose
+    /// `residual` they equal), without keeping u: what a report needs, at a fraction of
+    /// the memory traffic on large meshes. Errors: as [`Path::event_states`].
+    pub fn event_residuals(&self, range: std::ops::Range<usize>) -> Result<Vec<f64>> {
+        let mut out = Vec::with_capacity(range.len());
+        self.event_points(range, |_, _, r| out.push(r))?;
+        Ok(out)
+    }
+
+    /// Calls `each(k, u, residual)` for every event `k` in `range`, in order (u empty
+    /// without a solve).
+    /// One back-solve per transition point, in blocks of 32, with buffers reused between
+    /// blocks.
+    fn event_points(
+        &self,
+        range: std::ops::Range<usize>,
+        mut each: impl FnMut(usize, &[f64], f64),
+    ) -> Result<()> {
+        let tr = self.trace_ref()?;
         if range.end > tr.events.len() || range.start > range.end {
             return Err(Error::Usage(format!(
                 "events {}..{} do not exist ({} events)",
@@ -71,79 +100,98 @@ impl Path {
                 firsts.push(k);
             }
         }
-        let mut by_transition: Vec<State> = Vec::with_capacity(firsts.len());
+        const BLOCK: usize = 32;
         let del = self.problem.delassus();
         let m = 2 * self.problem.p();
-        for block in firsts.chunks(32) {
-            let mut x = crate::error::try_zeros(
-                if has_solve { n } else { 0 },
-                block.len(),
-                "the right-hand sides of the back-solves for u",
-            )?;
-            let mut lams = faer::Mat::<f64>::zeros(m, block.len());
-            let mut inputs = Vec::with_capacity(block.len());
-            // With half solves, only the backward half of each solve is done per event:
-            // the load's half is kept per load vector (affine and basis loads).
-            let cached = del.has_half_solve() && self.load.has_half();
+        let bs = firsts.len().min(BLOCK);
+        let nu = if has_solve { n } else { 0 };
+        let mut x =
+            crate::error::try_zeros(nu, bs, "the right-hand sides of the back-solves for u")?;
+        let mut u = crate::error::try_zeros(nu, bs, "the displacements u")?;
+        let mut lams = faer::Mat::<f64>::zeros(m, bs);
+        let nf = self.problem.delassus().load_len();
+        let mut fs = crate::error::try_zeros(nf, bs, "the loads at the events")?;
+        let mut scratch = Vec::new();
+        // With half solves, only the backward half of each solve is done per event:
+        // the load's half is kept per load vector (affine and basis loads).
+        let cached = has_solve && del.has_half_solve() && self.load.has_half();
+        let mut k_next = range.start;
+        for block in firsts.chunks(BLOCK) {
+            let kb = block.len();
+            let mut inputs = Vec::with_capacity(kb);
             for (c, &k) in block.iter().enumerate() {
                 let e = &tr.events[k];
                 let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
                 let lam = self.lam_to_internal(&lam);
-                let f = self.load.force_from(e.alpha, &tr.event_loads[k]);
+                let f = fs.col_mut(c).try_as_col_major_mut().expect("contiguous");
+                let f = f.as_slice_mut();
+                self.load.force_into(e.alpha, &tr.event_loads[k], f);
                 if has_solve {
                     for (i, &l) in lam.iter().enumerate() {
                         lams[(i, c)] = l;
                     }
-                    let col = match cached {
-                        true => self
-                            .load
-                            .half_solved_from(e.alpha, &tr.event_loads[k])
-                            .expect("a snapshot always matches its load"),
-                        false => f.clone(),
-                    };
-                    for (i, v) in col.into_iter().enumerate() {
-                        x[(i, c)] = v;
+                    let col = x.col_mut(c).try_as_col_major_mut().expect("contiguous");
+                    let col = col.as_slice_mut();
+                    if !(cached && self.load.half_solved_into(e.alpha, &tr.event_loads[k], col)) {
+                        col.copy_from_slice(f);
                     }
                 }
-                inputs.push((k, lam, f));
+                inputs.push(lam);
             }
-            let u = if !has_solve {
-                x
-            } else if del.has_half_solve() {
-                if !cached {
-                    // A general load: the loads' half here (the columns hold f).
-                    del.half_solve(x.as_mut())?;
-                }
-                del.displacements(x.as_mut(), lams.as_ref())?
-            } else {
-                for (c, (_, lam, _)) in inputs.iter().enumerate() {
-                    let mut bt = vec![0.0; n];
-                    self.problem.b().mul_t_vec_add(lam, &mut bt);
-                    for (i, v) in bt.into_iter().enumerate() {
-                        x[(i, c)] += v;
+            if has_solve {
+                let xs = x.as_mut().subcols_mut(0, kb);
+                let us = u.as_mut().subcols_mut(0, kb);
+                if del.has_half_solve() {
+                    if !cached {
+                        // A general load: the loads' half here (the columns hold f).
+                        del.half_solve(x.as_mut().subcols_mut(0, kb))?;
                     }
+                    del.displacements(
+                        x.as_mut().subcols_mut(0, kb),
+                        lams.as_ref().subcols(0, kb),
+                        us,
+                    )?;
+                } else {
+                    let mut xs = xs;
+                    for (c, lam) in inputs.iter().enumerate() {
+                        let col = xs
+                            .as_mut()
+                            .col_mut(c)
+                            .try_as_col_major_mut()
+                            .expect("contiguous");
+                        self.problem.b().mul_t_vec_add(lam, col.as_slice_mut());
+                    }
+                    del.solve_mat_in_place(xs.as_mut())?;
+                    u.as_mut().subcols_mut(0, kb).copy_from(xs.as_ref());
                 }
-                del.solve_mat_in_place(x.as_mut())?;
-                x
+            }
+            let ucol = |c: usize| -> &[f64] {
+                if has_solve {
+                    u.col(c).try_as_col_major().expect("contiguous").as_slice()
+                } else {
+                    &[]
+                }
             };
-            for (c, (k, lam, f)) in inputs.into_iter().enumerate() {
-                let e = &tr.events[k];
-                let uc: Vec<f64> = (0..u.nrows()).map(|i| u[(i, c)]).collect();
-                by_transition.push(self.state_from_u(&lam, e.alpha, &e.classes, &f, uc));
+            let points: Vec<(&[f64], &[f64], &[f64])> = inputs
+                .iter()
+                .enumerate()
+                .map(|(c, lam)| {
+                    let f = fs.col(c).try_as_col_major().expect("contiguous").as_slice();
+                    (ucol(c), &lam[..], f)
+                })
+                .collect();
+            // One pass over A for the residuals of the whole block.
+            let residuals = crate::piece::residuals(&self.problem, &points, &mut scratch);
+            // Every event of this block's transitions, in order.
+            for (c, &k0) in block.iter().enumerate() {
+                let t = tr.events[k0].transition;
+                while k_next < range.end && tr.events[k_next].transition == t {
+                    each(k_next, ucol(c), residuals[c]);
+                    k_next += 1;
+                }
             }
         }
-        let mut out = Vec::with_capacity(range.len());
-        let mut t = 0;
-        for k in range {
-            if t + 1 < firsts.len() && k >= firsts[t + 1] {
-                t += 1;
-            }
-            let mut s = by_transition[t].clone();
-            // Events of one transition share the point; the classes are the event's own.
-            s.classes = tr.events[k].classes.clone();
-            out.push(s);
-        }
-        Ok(out)
+        Ok(())
     }
 
     /// The pieces so far (the last one is the current piece; empty before the start).
