@@ -62,13 +62,18 @@ impl Path {
         let tol = self.tol_at(&pt);
         let table = self.guard_table(&cur.classes, &pt, Some((&cur.t, &cur.rate)));
         let mut best: Option<(f64, Guard)> = None;
+        let c = self.consts();
         for &GuardRow {
             guard: g,
             value: v,
             slope: vd,
         } in &table
         {
-            if vd < -tol.slope() {
+            // A decreasing guard leaves the piece where it reaches zero. Only a guard at
+            // zero whose slope is within the slope threshold counts as not decreasing (it
+            // was let in on that slope); one inside the piece that decreases however
+            // slowly does cross, and where it crosses first it is the exit.
+            if vd < -tol.slope() || (vd < 0.0 && !tol.at_zero(&c.guard_form(g), v, vd)) {
                 let s = (v / -vd).max(0.0);
                 if best.is_none_or(|b| s < b.0) {
                     best = Some((s, g));

@@ -45,6 +45,12 @@ impl Path {
     }
 
     /// Adds the directions of piece `classes` through `pt` that enter its region.
+    /// `switching`: the nodes that change class at the point. Their guards on the new
+    /// piece are the old class's equations or guards, so one near zero is zero by
+    /// construction: it is compared with the whole threshold of its terms (as at a start),
+    /// not with its rounding, and the way along the piece is decided by its slope (on a
+    /// slender strip the new slip guard of a node leaving stick came out at −2.4e-15, a
+    /// tenth of its threshold, with slope +1.1e-9, and no piece continued the path).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn push_candidates(
         &self,
@@ -52,10 +58,12 @@ impl Path {
         pt: &Point,
         scale: f64,
         tol: &Tol,
+        switching: &[usize],
         back: Option<(&[Class], &[f64])>,
         relaxed: bool,
         out: &mut Vec<Candidate>,
     ) {
+        let tol_switching = tol.clone().approximate();
         // The piece the path came from cannot continue it: its crossing guard decreases
         // forward, and backward is where the path came from.
         if back.is_some_and(|(bc, _)| bc == classes) {
@@ -91,7 +99,12 @@ impl Path {
                 // increase: its slope (force per unit of scaled arclength) against the
                 // scale of the point.
                 let form = c.guard_form(row.guard);
-                if !tol.at_zero(&form, v, vd) {
+                let tol_row = if switching.contains(&row.guard.node) {
+                    &tol_switching
+                } else {
+                    tol
+                };
+                if !tol_row.at_zero(&form, v, vd) {
                     return v > 0.0;
                 }
                 let ts = tol.slope();
@@ -199,11 +212,11 @@ impl Path {
                     .collect();
                 for s in [1.0, -1.0] {
                     if let Some(cl) = self.directional_classes(pt, &frozen, s) {
-                        self.push_candidates(&cl, pt, scale, &tol, back, relaxed, &mut out);
+                        self.push_candidates(&cl, pt, scale, &tol, nodes, back, relaxed, &mut out);
                     }
                 }
             } else {
-                self.push_candidates(&classes, pt, scale, &tol, back, relaxed, &mut out);
+                self.push_candidates(&classes, pt, scale, &tol, nodes, back, relaxed, &mut out);
             }
             // next combination
             let mut k = 0;
