@@ -206,6 +206,17 @@ fn node_permutations() {
     }
 }
 
+/// `data` with node i's rows N_i, T_i and gap g_i multiplied by `c[i]`.
+fn rows_scaled(data: &Data, c: &[f64]) -> Data {
+    let mut q = data.clone();
+    for (i, &ci) in c.iter().enumerate() {
+        q.nm.row_mut(i).scale_mut(ci);
+        q.tm.row_mut(i).scale_mut(ci);
+        q.gap[i] *= ci;
+    }
+    q
+}
+
 /// Per-node scaling: multiplying node i's rows N_i, T_i and gap g_i by c_i > 0 (spread
 /// over 1e-6 … 1e6) is the same problem with λ_i divided by c_i.
 #[test]
@@ -224,12 +235,7 @@ fn per_node_row_scalings() {
         let p = data.p;
         let mut rng = Rng::new(k as u64 + 4242);
         let c: Vec<f64> = (0..p).map(|_| 10f64.powf(rng.range(-6.0, 6.0))).collect();
-        let mut q = data.clone();
-        for (i, &ci) in c.iter().enumerate() {
-            q.nm.row_mut(i).scale_mut(ci);
-            q.tm.row_mut(i).scale_mut(ci);
-            q.gap[i] *= ci;
-        }
+        let q = rows_scaled(data, &c);
         let base = run(data, case.a0, case.a1);
         let path = run(&q, case.a0, case.a1);
         let ctx = format!("case {k} (seed {}), factors {c:?}", case.seed);
@@ -325,7 +331,6 @@ fn per_node_row_scalings_at_extreme_sizes() {
     for seed in 0..20u64 {
         let case = random_case(seed);
         let data = &case.data;
-        let mut q = data.clone();
         let c: Vec<f64> = (0..data.p)
             .map(|i| {
                 if (i + seed as usize).is_multiple_of(2) {
@@ -335,11 +340,7 @@ fn per_node_row_scalings_at_extreme_sizes() {
                 }
             })
             .collect();
-        for (i, &ci) in c.iter().enumerate() {
-            q.nm.row_mut(i).scale_mut(ci);
-            q.tm.row_mut(i).scale_mut(ci);
-            q.gap[i] *= ci;
-        }
+        let q = rows_scaled(data, &c);
         let base = run(data, case.a0, case.a1);
         let path = run(&q, case.a0, case.a1);
         let ctx = format!("seed {seed}, factors {c:?}");
