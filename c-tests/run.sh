@@ -50,6 +50,7 @@ build status $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/status.c c-tests/
 build paths $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/paths.c c-tests/common.c -o "$OUT/paths" "${LINK[@]}" -lm -lpthread
 build cholmod_ref $C -I/usr/include/suitesparse "${WARN[@]}" c-tests/cholmod_ref.c c-tests/common.c -o "$OUT/cholmod_ref" "${LINK[@]}" -lcholmod -lm
 build monitor $C "${WARN[@]}" c-tests/monitor.c c-tests/common.c -o "$OUT/monitor" "${LINK[@]}" -lm
+build start_branches $C "${WARN[@]}" c-tests/start_branches.c c-tests/common.c -o "$OUT/start_branches" "${LINK[@]}" -lm
 build csr_input $C "${WARN[@]}" c-tests/csr_input.c c-tests/common.c -o "$OUT/csr_input" "${LINK[@]}" -lm
 build oom $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/oom.c c-tests/common.c -o "$OUT/oom" "${LINK[@]}" -lm
 build scales $C "${WARN[@]}" c-tests/scales.c c-tests/common.c -o "$OUT/scales" "${LINK[@]}" -lm
@@ -151,6 +152,7 @@ else
     fail "sample case not found at $SAMPLE (set FRICONT_CASES)"
 fi
 run "loads and threads: Q1 example" "$OUT/paths" "$Q1"
+run "branches at the start: vertex-start" "$OUT/start_branches" "$CASES/vertex-start"
 if [ -f "$SAMPLE/meta.json" ]; then
     run "extreme scales of A: sample" "$OUT/scales" "$SAMPLE"
 fi
@@ -218,6 +220,7 @@ if command -v valgrind >/dev/null; then
     if [ -f "$SAMPLE/meta.json" ]; then
         run "valgrind CHOLMOD reference: sample" "${VG[@]}" "$OUT/cholmod_ref" "$SAMPLE"
         run "valgrind monitor, largest step, re-entrant callbacks: sample" "${VG[@]}" "$OUT/monitor" "$SAMPLE"
+        run "valgrind branches at the start: vertex-start" "${VG[@]}" "$OUT/start_branches" "$CASES/vertex-start"
     fi
 else
     echo "skip valgrind (not installed)"

@@ -332,6 +332,30 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
     let t1 = Instant::now();
     path.start(alpha_start, None)
         .map_err(|e| runtime(format!("start at alpha = {alpha_start}: {e}")))?;
+    let branches = path.branches();
+    if let Some(first) = branches.first() {
+        // A bifurcation at the start: say which pieces leave it (by the nodes where they
+        // differ, 1-based) and which one is traced.
+        let differ: Vec<usize> = (0..first.classes.len())
+            .filter(|&i| branches.iter().any(|b| b.classes[i] != first.classes[i]))
+            .collect();
+        let list: Vec<String> = branches
+            .iter()
+            .enumerate()
+            .map(|(k, b)| {
+                let nodes: Vec<String> = differ
+                    .iter()
+                    .map(|&i| format!("node {} {}", i + 1, b.classes[i].name()))
+                    .collect();
+                format!("{}: {}", k + 1, nodes.join(", "))
+            })
+            .collect();
+        eprintln!(
+            "fricont: note: {} pieces leave the start point toward alpha_end (a bifurcation); tracing the first [{}]",
+            branches.len(),
+            list.join("; ")
+        );
+    }
     progress.phase(&format!(
         "tracing from alpha = {alpha_start} toward {alpha_end}"
     ));

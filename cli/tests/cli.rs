@@ -1126,3 +1126,27 @@ fn sample_events_confirmed_by_fixed_alpha_solves() {
     }
     assert_eq!(confirmed, events.len());
 }
+
+/// A bifurcation at the start point is said on stderr, with the pieces that leave it
+/// (tests/data/vertex-start: the brute force of tests/common finds the three curves
+/// (open, slip+), (slip-, slip+), (stick, slip-) leaving alpha = 0 toward -1), and the
+/// table (stdout) is the first branch's.
+#[test]
+fn start_bifurcation_is_reported() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/data/vertex-start");
+    let o = run(&["trace", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("3 pieces leave the start point toward alpha_end")
+            && err.contains("node 1 open, node 2 slip+")
+            && err.contains("node 1 slip-, node 2 slip+")
+            && err.contains("node 1 stick, node 2 slip-"),
+        "{err}"
+    );
+    assert!(
+        stdout(&o).contains("1 open, 0 stick, 1 slip+, 0 slip-"),
+        "{}",
+        stdout(&o)
+    );
+}
