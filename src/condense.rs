@@ -571,12 +571,7 @@ impl Delassus {
             for (i, &j) in fwd.iter().enumerate() {
                 uc[j] = self.h * yc[i];
             }
-            check_u(
-                uc.as_ref()
-                    .try_as_col_major()
-                    .expect("contiguous")
-                    .as_slice(),
-            )?;
+            check_u(uc.as_ref().iter().copied())?;
         }
         Ok(())
     }
@@ -654,7 +649,7 @@ impl Delassus {
             x *= faer::Scale(self.h);
         }
         for c in 0..x.ncols() {
-            check_u(&x.as_ref().col(c).iter().copied().collect::<Vec<_>>())?;
+            check_u(x.as_ref().col(c).iter().copied())?;
         }
         Ok(())
     }
@@ -720,7 +715,7 @@ impl Delassus {
         let n = x.len();
         self.solve_scaled(faer::MatMut::from_column_major_slice_mut(&mut x, n, 1))?;
         x.iter_mut().for_each(|v| *v *= self.h);
-        check_u(&x)?;
+        check_u(x.iter().copied())?;
         Ok(x)
     }
 
@@ -785,13 +780,12 @@ impl Delassus {
 
 /// A displacement that is not finite: the caller's u does not fit in a double (a tiny A
 /// and a large load): [`Error::Numerical`] instead of an infinite u.
-fn check_u(u: &[f64]) -> Result<()> {
-    match u.iter().position(|v| !v.is_finite()) {
+fn check_u(u: impl Iterator<Item = f64>) -> Result<()> {
+    match u.enumerate().find(|(_, v)| !v.is_finite()) {
         None => Ok(()),
-        Some(i) => Err(Error::Numerical(format!(
-            "the displacement u overflows (entry {} is {}): u = A^-1 (f + B^T lambda) is beyond the range of a double for this A and load (A tiny compared with f? scale A and the loads alike)",
+        Some((i, v)) => Err(Error::Numerical(format!(
+            "the displacement u overflows (entry {} is {v}): u = A^-1 (f + B^T lambda) is beyond the range of a double for this A and load (A tiny compared with f? scale A and the loads alike)",
             i + 1,
-            u[i]
         ))),
     }
 }

@@ -559,8 +559,9 @@ pub fn residuals(
         let hs = crate::problem::mul_pow2(1.0, problem.a_scale_log2() / 2);
         let k = points.len();
         // u of all points interleaved (row j holds u_c[j] for every point c), so that the
-        // pass over A reads each point's entries next to each other.
-        // Both in tiles of rows, so that the point-by-point reads and writes stay in cache.
+        // pass over A reads each point's entries next to each other; this copy and the
+        // pass go by tiles of rows, so that the point-by-point reads and writes stay in
+        // cache.
         const TILE: usize = 64;
         scratch.resize(n * k, 0.0);
         let ut = &mut scratch[..n * k];

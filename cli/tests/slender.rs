@@ -22,6 +22,15 @@ use common::{Brute, fe_case, fold_problem, mirror_pair, random_case, symmetric_c
 use fricont::Class;
 use fricont_exchange::generator::{RectSpec, generate};
 
+/// The brute-force piece containing `a0`, when it is unique (away from breakpoints).
+fn start_piece(br: &Brute, a0: f64) -> Option<&common::BrutePiece> {
+    let mut inside = br.pieces.iter().filter(|pc| pc.lo < a0 && a0 < pc.hi);
+    match (inside.next(), inside.next()) {
+        (Some(pc), None) => Some(pc),
+        _ => None,
+    }
+}
+
 fn no_progress() -> impl FnMut(usize, f64) {
     |_, _| {}
 }
@@ -107,29 +116,17 @@ fn reference_matches_brute_force_walks() {
     let total = cases.len();
     for case in cases {
         let br = Brute::new(&case.data);
-        // The piece containing the start (unique away from breakpoints).
-        let start: Vec<_> = br
-            .pieces
-            .iter()
-            .filter(|pc| pc.lo < case.a0 && case.a0 < pc.hi)
-            .collect();
-        if start.len() != 1 {
+        let Some(start) = start_piece(&br, case.a0) else {
             continue;
-        }
-        let Some(walk) = br.walk(case.a0, case.a1, &start[0].lambda(case.a0)) else {
+        };
+        let Some(walk) = br.walk(case.a0, case.a1, &start.lambda(case.a0)) else {
             continue;
         };
         if walk.closed {
             continue;
         }
         let cond = Condensed::from_data(&case.data);
-        let tr = cond.trace(
-            &start[0].classes,
-            case.a0,
-            case.a1,
-            1000,
-            &mut no_progress(),
-        );
+        let tr = cond.trace(&start.classes, case.a0, case.a1, 1000, &mut no_progress());
         let ctx = format!("seed {} (p = {})", case.seed, case.data.p);
         assert!(tr.end.is_ok(), "{ctx}: reference stopped: {:?}", tr.end);
         let want: Vec<Ev> = walk
@@ -164,16 +161,11 @@ fn reference_degenerate_transitions_match_brute_force() {
     for seed in 0..24 {
         let case = symmetric_case(seed, seed % 2 == 1);
         let br = Brute::new(&case.data);
-        let start: Vec<_> = br
-            .pieces
-            .iter()
-            .filter(|pc| pc.lo < case.a0 && case.a0 < pc.hi)
-            .collect();
-        if start.len() != 1 {
+        let Some(start) = start_piece(&br, case.a0) else {
             continue;
-        }
+        };
         let cond = Condensed::from_data(&case.data);
-        let tr = cond.trace(&start[0].classes, case.a0, case.a1, 200, &mut no_progress());
+        let tr = cond.trace(&start.classes, case.a0, case.a1, 200, &mut no_progress());
         let ctx = format!("symmetric seed {seed}");
         let continuations = |k: usize| {
             let (cl, _, at) = &tr.pieces[k];

@@ -63,12 +63,12 @@ impl Path {
         relaxed: bool,
         out: &mut Vec<Candidate>,
     ) {
-        let tol_switching = tol.clone().approximate();
         // The piece the path came from cannot continue it: its crossing guard decreases
         // forward, and backward is where the path came from.
         if back.is_some_and(|(bc, _)| bc == classes) {
             return;
         }
+        let tol_switching = tol.clone().approximate();
         let Some(PieceTangent {
             t,
             lu,
@@ -319,18 +319,9 @@ impl Path {
         } else {
             Some(0)
         };
-        let m = 2 * self.problem.p();
         let branches: Vec<Branch> = cands
             .iter()
-            .map(|c| Branch {
-                classes: c.classes.clone(),
-                direction: if c.scales.is_vertical(&c.t) {
-                    0
-                } else {
-                    sign(c.t[m])
-                },
-                orientation_preserving: c.orientation == sigma,
-            })
+            .map(|c| c.branch(c.orientation == sigma))
             .collect();
         let pending = PendingJoin {
             point: pt,
@@ -406,15 +397,10 @@ impl Path {
 
     /// Moves onto candidate `k` of a pending transition and records its events.
     pub(super) fn apply(&mut self, pend: &PendingJoin, k: usize) -> Result<StepOutcome> {
-        let m = 2 * self.problem.p();
         let cand = pend.cands[k].clone();
         self.commit_solver(&cand.lu);
         let pt = pend.point.clone();
-        let dir = if cand.scales.is_vertical(&cand.t) {
-            0
-        } else {
-            sign(cand.t[m])
-        };
+        let dir = cand.direction();
         let fold = dir != 0 && pend.last_dir != 0 && dir != pend.last_dir;
         let scale = self.force_scale(&pt);
         let a_s = cand.scales.alpha;
@@ -518,16 +504,8 @@ impl Path {
     /// Records a bifurcation at the start point: `cands` (the first taken) all leave it
     /// toward alpha_end.
     pub(super) fn offer_start_branches(&mut self, pt: Point, cands: Vec<Candidate>) {
-        let m = 2 * self.problem.p();
         let tr = self.trace.as_mut().expect("started");
-        tr.branches = cands
-            .iter()
-            .map(|c| Branch {
-                classes: c.classes.clone(),
-                direction: sign(c.t[m]),
-                orientation_preserving: true,
-            })
-            .collect();
+        tr.branches = cands.iter().map(|c| c.branch(true)).collect();
         tr.pending = Some(PendingJoin {
             point: pt,
             from: cands[0].classes.clone(),
@@ -543,7 +521,8 @@ impl Path {
     /// Continue along candidate `k` of [`Path::branches`] instead of the one taken (or
     /// after the path stopped with [`EndReason::Bifurcation`]). Only allowed directly after
     /// the bifurcation step, or directly after [`Path::start`] when it offered branches
-    /// (the path then starts again at the same point on branch `k`). Errors: not started, no bifurcation pending, `k` out of range.
+    /// (the path then starts again at the same point on branch `k`). Errors: not started,
+    /// no bifurcation pending, `k` out of range.
     pub fn choose_branch(&mut self, k: usize) -> Result<()> {
         let tr = self
             .trace
@@ -574,8 +553,7 @@ impl Path {
         if pend.at_start {
             let want = sign(self.opts.alpha_end - self.opts.alpha_start);
             let branches = std::mem::take(&mut tr.branches);
-            *self.updater.borrow_mut() = None;
-            let res = self.begin(&pend.point, pend.cands[k].clone(), want);
+            let res = self.begin_afresh(&pend.point, pend.cands[k].clone(), want);
             let tr = self.trace.as_mut().expect("started");
             tr.branches = branches;
             tr.pending = Some(pend);

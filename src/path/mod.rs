@@ -460,6 +460,26 @@ struct Candidate {
     xp: Option<Arc<Vec<f64>>>,
 }
 
+impl Candidate {
+    /// Sign of dα/ds along the candidate (0 for a vertical piece).
+    fn direction(&self) -> i8 {
+        if self.scales.is_vertical(&self.t) {
+            0
+        } else {
+            sign(self.t[self.t.len() - 1])
+        }
+    }
+
+    /// The candidate as the caller sees it.
+    fn branch(&self, orientation_preserving: bool) -> Branch {
+        Branch {
+            classes: self.classes.clone(),
+            direction: self.direction(),
+            orientation_preserving,
+        }
+    }
+}
+
 /// How a piece's equations are solved: a full-pivoting LU of the Jacobian in scaled
 /// coordinates (vertical pieces, and every piece when
 /// [`PathOptions::fresh_factorisations`] is set), or `M_S` by updates of a base.
@@ -1082,7 +1102,7 @@ impl Path {
         }
         let ms = 2 * p;
         let toward: Vec<usize> = (0..cands.len())
-            .filter(|&k| !cands[k].scales.is_vertical(&cands[k].t) && sign(cands[k].t[ms]) == want)
+            .filter(|&k| cands[k].direction() == want)
             .collect();
         if let Some(&k) = toward.first() {
             self.begin(&pt, cands[k].clone(), want)?;
@@ -1096,7 +1116,7 @@ impl Path {
             return Ok(());
         }
         let verticals: Vec<usize> = (0..cands.len())
-            .filter(|&k| cands[k].scales.is_vertical(&cands[k].t))
+            .filter(|&k| cands[k].direction() == 0)
             .collect();
         let Some(&first) = verticals.first() else {
             return Err(Error::Numerical(format!(
@@ -1108,8 +1128,7 @@ impl Path {
         // leads toward alpha_end shows only where the path leaves it. Follow each way to
         // the first piece that moves α, and keep the one that moves it toward alpha_end.
         for &k in &verticals {
-            *self.updater.borrow_mut() = None;
-            self.begin(&pt, cands[k].clone(), want)?;
+            self.begin_afresh(&pt, cands[k].clone(), want)?;
             for _ in 0..16 {
                 match self.step() {
                     Ok(StepOutcome::Transition { .. }) => {
@@ -1125,23 +1144,24 @@ impl Path {
                 }
             }
         }
+        self.begin_afresh(&pt, cands[first].clone(), want)
+    }
+
+    /// [`Self::begin`] with no factorisation kept from what the path did before (a probe
+    /// along another way, another branch).
+    fn begin_afresh(&mut self, pt: &Point, cand: Candidate, want: i8) -> Result<()> {
         *self.updater.borrow_mut() = None;
-        self.begin(&pt, cands[first].clone(), want)
+        self.begin(pt, cand, want)
     }
 
     /// Starts the trace at `pt` on candidate `cand` (`want`: the sign of α's way toward
     /// alpha_end).
     fn begin(&mut self, pt: &Point, cand: Candidate, want: i8) -> Result<()> {
-        let ms = 2 * self.problem.p();
         let alpha = pt.alpha;
         let pt = pt.clone();
         self.commit_solver(&cand.lu);
         let start = self.state(&pt.lam, alpha, &cand.classes)?;
-        let dir = if cand.scales.is_vertical(&cand.t) {
-            0
-        } else {
-            sign(cand.t[ms])
-        };
+        let dir = cand.direction();
         let piece = PieceRecord {
             classes: cand.classes.clone(),
             alpha_from: alpha,

@@ -52,11 +52,9 @@ impl Path {
     pub fn event_states(&self, range: std::ops::Range<usize>) -> Result<Vec<State>> {
         let tr = self.trace_ref()?;
         let mut states = Vec::with_capacity(range.len());
-        self.event_points(range.clone(), |k, u, residual| {
+        self.event_points(range.clone(), |k, u, lam, residual| {
             let e = &tr.events[k];
-            let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
-            let lam = self.lam_to_internal(&lam);
-            states.push(self.state_with(&lam, e.alpha, &e.classes, u.to_vec(), residual));
+            states.push(self.state_with(lam, e.alpha, &e.classes, u.to_vec(), residual));
         })?;
         Ok(states)
     }
@@ -66,18 +64,18 @@ impl Path {
     /// the memory traffic on large meshes. Errors: as [`Path::event_states`].
     pub fn event_residuals(&self, range: std::ops::Range<usize>) -> Result<Vec<f64>> {
         let mut out = Vec::with_capacity(range.len());
-        self.event_points(range, |_, _, r| out.push(r))?;
+        self.event_points(range, |_, _, _, r| out.push(r))?;
         Ok(out)
     }
 
-    /// Calls `each(k, u, residual)` for every event `k` in `range`, in order (u empty
-    /// without a solve).
+    /// Calls `each(k, u, λ, residual)` for every event `k` in `range`, in order (u empty
+    /// without a solve; λ internal, shared by the events of a transition).
     /// One back-solve per transition point, in blocks of 32, with buffers reused between
     /// blocks.
     fn event_points(
         &self,
         range: std::ops::Range<usize>,
-        mut each: impl FnMut(usize, &[f64], f64),
+        mut each: impl FnMut(usize, &[f64], &[f64], f64),
     ) -> Result<()> {
         let tr = self.trace_ref()?;
         if range.end > tr.events.len() || range.start > range.end {
@@ -139,20 +137,15 @@ impl Path {
                 inputs.push(lam);
             }
             if has_solve {
-                let xs = x.as_mut().subcols_mut(0, kb);
-                let us = u.as_mut().subcols_mut(0, kb);
+                let mut xs = x.as_mut().subcols_mut(0, kb);
+                let mut us = u.as_mut().subcols_mut(0, kb);
                 if del.has_half_solve() {
                     if !cached {
                         // A general load: the loads' half here (the columns hold f).
-                        del.half_solve(x.as_mut().subcols_mut(0, kb))?;
+                        del.half_solve(xs.as_mut())?;
                     }
-                    del.displacements(
-                        x.as_mut().subcols_mut(0, kb),
-                        lams.as_ref().subcols(0, kb),
-                        us,
-                    )?;
+                    del.displacements(xs, lams.as_ref().subcols(0, kb), us)?;
                 } else {
-                    let mut xs = xs;
                     for (c, lam) in inputs.iter().enumerate() {
                         let col = xs
                             .as_mut()
@@ -162,7 +155,7 @@ impl Path {
                         self.problem.b().mul_t_vec_add(lam, col.as_slice_mut());
                     }
                     del.solve_mat_in_place(xs.as_mut())?;
-                    u.as_mut().subcols_mut(0, kb).copy_from(xs.as_ref());
+                    us.copy_from(xs.as_ref());
                 }
             }
             let ucol = |c: usize| -> &[f64] {
@@ -186,7 +179,7 @@ impl Path {
             for (c, &k0) in block.iter().enumerate() {
                 let t = tr.events[k0].transition;
                 while k_next < range.end && tr.events[k_next].transition == t {
-                    each(k_next, ucol(c), residuals[c]);
+                    each(k_next, ucol(c), &inputs[c], residuals[c]);
                     k_next += 1;
                 }
             }
