@@ -47,6 +47,7 @@
 
 pub mod class;
 pub mod condense;
+mod dd;
 mod dense;
 pub mod error;
 pub mod ffi;

@@ -718,8 +718,15 @@ pub(crate) fn mul_pow2(mut x: f64, mut e: i32) -> f64 {
     x
 }
 
+/// The largest power of two ≤ `s > 0` (up to the rounding of log2): a scale by which
+/// every division is exact, so that equilibrating changes no digit of the data.
+fn pow2_below(s: f64) -> f64 {
+    mul_pow2(1.0, (s.log2().floor() as i32).clamp(-1074, 1023))
+}
+
 /// Equilibration: node i's rows N_i, T_i (and gap g_i) divided by
-/// `s_i = max(‖N_i‖₂, ‖T_i‖₂)`. The problem is invariant under such a per-node scaling
+/// `s_i`, the power of two at or below `max(‖N_i‖₂, ‖T_i‖₂)` (the rows are then of size
+/// 1 … 2, and the scaled data are the caller's digits exactly). The problem is invariant under such a per-node scaling
 /// (λ_i scales by s_i), and with unit rows no node's forces are measured on another
 /// node's scale. Returns `B = [N; T] / s` (2p×n) and the scales.
 fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMatrix, Vec<f64>)> {
@@ -744,7 +751,11 @@ fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMat
     let node_scale: Vec<f64> = (0..p)
         .map(|i| {
             let s = row_norm(n, i).max(row_norm(t, i));
-            if s.is_finite() && s > 0.0 { s } else { 1.0 }
+            if s.is_finite() && s > 0.0 {
+                pow2_below(s)
+            } else {
+                1.0
+            }
         })
         .collect();
     let mut trip = Vec::with_capacity(n.nnz() + t.nnz());
@@ -760,8 +771,9 @@ fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMat
 
 /// Checks a caller's W (finite, symmetric to 1e-10 relative, positive definite with a
 /// relative pivot above 1e-12) and equilibrates it as [`equilibrated_b`] would the rows of
-/// B: `s_i = sqrt(max(W_ii, W_{p+i,p+i}))` (node i's rows of B in the A⁻¹ norm), so the
-/// internal W has node diagonals ≤ 1. Returns `S⁻¹ W S⁻¹` and the scales.
+/// B: `s_i` the power of two at or below `sqrt(max(W_ii, W_{p+i,p+i}))` (node i's rows of
+/// B in the A⁻¹ norm), so the internal W has node diagonals < 4 and keeps the caller's
+/// digits. Returns `S⁻¹ W S⁻¹` and the scales.
 fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
     let m = w.nrows();
     let p = m / 2;
@@ -811,14 +823,15 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
         )));
     }
     let node_scale: Vec<f64> = (0..p)
-        .map(|i| w[(i, i)].max(w[(p + i, p + i)]).sqrt())
+        .map(|i| pow2_below(w[(i, i)].max(w[(p + i, p + i)]).sqrt()))
         .collect();
     let sc = |k: usize| node_scale[k % p];
     let mut w_int = try_zeros(m, m, "the equilibrated W")?;
     for j in 0..m {
         for i in 0..m {
             // (no overflow for entries near f64::MAX)
-            w_int[(i, j)] = (0.5 * w[(i, j)] + 0.5 * w[(j, i)]) / (sc(i) * sc(j));
+            // (no overflow of the product of two scales near 2^512 either)
+            w_int[(i, j)] = (0.5 * w[(i, j)] + 0.5 * w[(j, i)]) / sc(i) / sc(j);
         }
     }
     let pivot_err = |j: usize, d: f64| {

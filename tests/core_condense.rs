@@ -69,13 +69,13 @@ fn wide_rows_fall_back_to_solves_and_match_a_dense_reference() {
     .build()
     .unwrap();
     let am = DMatrix::from_row_slice(nd, nd, &a);
-    // The library equilibrates each node's rows by max(‖N_i‖₂, ‖T_i‖₂): so does the
-    // reference, from the rows themselves.
+    // The library equilibrates each node's rows by the power of two at or below
+    // max(‖N_i‖₂, ‖T_i‖₂): so does the reference, from the rows themselves.
     let norm = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt();
     let mut b = DMatrix::zeros(2 * p, nd);
     for i in 0..p {
         let (nr, tr) = (&nrows[i * nd..(i + 1) * nd], &trows[i * nd..(i + 1) * nd]);
-        let s = norm(nr).max(norm(tr));
+        let s = 2f64.powf(norm(nr).max(norm(tr)).log2().floor());
         assert_eq!(pb.node_scale()[i], s);
         for j in 0..nd {
             b[(i, j)] = nr[j] / s;

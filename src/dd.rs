@@ -1,0 +1,176 @@
+//! Double-double numbers: an unevaluated sum `hi + lo` with `|lo| ≤ ulp(hi)/2`, about 32
+//! significant digits, from error-free transformations (Knuth's two-sum, the fused
+//! multiply-add's exact product error). Used where the data are exact doubles but a
+//! quantity derived from them (W of a slender body, the point of a transition on its
+//! piece) is needed beyond double precision: mixed-precision refinement computes residuals
+//! in double-double and corrections with the ordinary double factorisations.
+
+use std::ops::{Add, Mul, Neg, Sub};
+
+/// `a + b = s + e` exactly (Knuth's two-sum: no assumption on the sizes).
+#[inline]
+pub(crate) fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    let e = (a - (s - bb)) + (b - bb);
+    (s, e)
+}
+
+/// `a · b = p + e` exactly (p the rounded product, e from a fused multiply-add).
+#[inline]
+pub(crate) fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    (p, a.mul_add(b, -p))
+}
+
+/// A double-double number `hi + lo`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct Dd {
+    pub hi: f64,
+    pub lo: f64,
+}
+
+impl Dd {
+    pub const ZERO: Dd = Dd { hi: 0.0, lo: 0.0 };
+
+    /// The double `x` as a double-double.
+    #[inline]
+    pub fn from(x: f64) -> Dd {
+        Dd { hi: x, lo: 0.0 }
+    }
+
+    /// `hi + lo` renormalised.
+    #[inline]
+    pub fn new(hi: f64, lo: f64) -> Dd {
+        let (s, e) = two_sum(hi, lo);
+        Dd { hi: s, lo: e }
+    }
+
+    /// The nearest double.
+    #[inline]
+    pub fn to_f64(self) -> f64 {
+        self.hi + self.lo
+    }
+
+    /// `a · b` of two doubles, exactly.
+    #[inline]
+    pub fn prod(a: f64, b: f64) -> Dd {
+        let (p, e) = two_prod(a, b);
+        Dd { hi: p, lo: e }
+    }
+
+    /// `self + x` for a double x.
+    #[inline]
+    pub fn add_f64(self, x: f64) -> Dd {
+        let (s, e) = two_sum(self.hi, x);
+        Dd::new(s, e + self.lo)
+    }
+
+    /// `self · x` for a double x.
+    #[inline]
+    pub fn mul_f64(self, x: f64) -> Dd {
+        let (p, e) = two_prod(self.hi, x);
+        Dd::new(p, e + self.lo * x)
+    }
+
+    /// `self / other` (one Newton correction of the double quotient).
+    #[inline]
+    pub fn div(self, other: Dd) -> Dd {
+        let q1 = self.hi / other.hi;
+        let r = self - other.mul_f64(q1);
+        let q2 = r.hi / other.hi;
+        let r = r - other.mul_f64(q2);
+        let q3 = r.hi / other.hi;
+        Dd::new(q1, q2).add_f64(q3)
+    }
+
+    pub fn is_finite(self) -> bool {
+        self.hi.is_finite() && self.lo.is_finite()
+    }
+}
+
+impl Add for Dd {
+    type Output = Dd;
+    #[inline]
+    fn add(self, o: Dd) -> Dd {
+        let (s, e) = two_sum(self.hi, o.hi);
+        let (t, f) = two_sum(self.lo, o.lo);
+        let r = Dd::new(s, e + t);
+        Dd::new(r.hi, r.lo + f)
+    }
+}
+
+impl Neg for Dd {
+    type Output = Dd;
+    #[inline]
+    fn neg(self) -> Dd {
+        Dd {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
+    }
+}
+
+impl Sub for Dd {
+    type Output = Dd;
+    #[inline]
+    fn sub(self, o: Dd) -> Dd {
+        self + (-o)
+    }
+}
+
+impl Mul for Dd {
+    type Output = Dd;
+    #[inline]
+    fn mul(self, o: Dd) -> Dd {
+        let (p, e) = two_prod(self.hi, o.hi);
+        Dd::new(p, e + (self.hi * o.lo + self.lo * o.hi))
+    }
+}
+
+/// `Σ a_k x_k` in double-double for double `a` and double-double `x = x_hi + x_lo`
+/// (the `a_k x_lo,k` terms, already tiny, summed in double): the compensated dot
+/// product of Ogita, Rump and Oishi with the low parts added.
+#[inline]
+pub(crate) fn dot_dd(a: &[f64], x_hi: &[f64], x_lo: &[f64]) -> Dd {
+    let (mut s, mut c) = (0.0f64, 0.0f64);
+    for k in 0..a.len() {
+        let (p, e) = two_prod(a[k], x_hi[k]);
+        let (s2, f) = two_sum(s, p);
+        s = s2;
+        c += e + f + a[k] * x_lo[k];
+    }
+    Dd::new(s, c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_transformations() {
+        // 1 + 2^-60 is not a double; its parts are kept.
+        let (s, e) = two_sum(1.0, 2f64.powi(-60));
+        assert_eq!((s, e), (1.0, 2f64.powi(-60)));
+        // (1 + 2^-30)^2 = 1 + 2^-29 + 2^-60
+        let x = 1.0 + 2f64.powi(-30);
+        let (p, e) = two_prod(x, x);
+        assert_eq!(p, 1.0 + 2f64.powi(-29));
+        assert_eq!(e, 2f64.powi(-60));
+    }
+
+    #[test]
+    fn division_and_dot_beyond_double() {
+        // 1/3 in double-double: 3 · (1/3) − 1 vanishes to ~1e-32.
+        let third = Dd::from(1.0).div(Dd::from(3.0));
+        let back = third.mul_f64(3.0) - Dd::from(1.0);
+        assert!(back.to_f64().abs() < 1e-31, "{back:?}");
+        // A cancelling dot product: 1e16 + 1 − 1e16 = 1 (double gives 0 or 2).
+        let d = dot_dd(&[1e16, 1.0, -1e16], &[1.0, 1.0, 1.0], &[0.0; 3]);
+        assert_eq!(d.to_f64(), 1.0);
+        // The low parts count: x = 1 + 2^-70 as (1, 2^-70), 2^70 x − 2^70 = 1.
+        let t70 = 2f64.powi(70);
+        let d = dot_dd(&[t70, -t70], &[1.0, 1.0], &[2f64.powi(-70), 0.0]);
+        assert_eq!(d.to_f64(), 1.0);
+    }
+}
