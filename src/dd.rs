@@ -173,4 +173,80 @@ mod tests {
         let d = dot_dd(&[t70, -t70], &[1.0, 1.0], &[2f64.powi(-70), 0.0]);
         assert_eq!(d.to_f64(), 1.0);
     }
+
+    #[test]
+    fn symmetric_products_agree_with_the_scalar_dot() {
+        // A symmetric W of mixed sizes (m = 11: two lanes' chunks and a remainder).
+        let m = 11;
+        let w = faer::Mat::<f64>::from_fn(m, m, |i, j| {
+            let (a, b) = (i.min(j) as f64, i.max(j) as f64);
+            (1.0 + a * 0.37 + b * 1.3).sin() * 10f64.powi(((a + b) as i32 % 7) - 3)
+        });
+        let xh: Vec<f64> = (0..m).map(|i| (i as f64 * 0.9).cos() * 1e3).collect();
+        let xl: Vec<f64> = xh.iter().map(|v| v * 1e-17).collect();
+        let got = sym_gemv_dd(w.as_ref(), &[(&xh, &xl)]);
+        for k in 0..m {
+            let col: Vec<f64> = (0..m).map(|i| w[(i, k)]).collect();
+            let want = dot_dd(&col, &xh, &xl);
+            let d = (got[0][k] - want).to_f64().abs();
+            assert!(d <= 1e-30 * want.to_f64().abs().max(1.0), "row {k}: {d:e}");
+        }
+    }
+}
+
+/// `W x` in double-double for the symmetric `W` (m × m, column-major, each column
+/// contiguous) and each double-double vector `x = x_hi + x_lo` of `xs`: row k is read as
+/// column k, and every dot product runs in four independent lanes (compensated), compiled
+/// for the machine's vector instructions with fused multiply-adds by faer's dispatch.
+pub(crate) fn sym_gemv_dd(w: faer::MatRef<'_, f64>, xs: &[(&[f64], &[f64])]) -> Vec<Vec<Dd>> {
+    let mut out = vec![vec![Dd::ZERO; w.nrows()]; xs.len()];
+    faer::traits::pulp::Arch::new().dispatch(GemvDd {
+        w,
+        xs,
+        out: &mut out,
+    });
+    out
+}
+
+struct GemvDd<'a> {
+    w: faer::MatRef<'a, f64>,
+    xs: &'a [(&'a [f64], &'a [f64])],
+    out: &'a mut [Vec<Dd>],
+}
+
+impl faer::traits::pulp::WithSimd for GemvDd<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) {
+        let m = self.w.nrows();
+        for k in 0..m {
+            let col = self.w.col(k).try_as_col_major().expect("contiguous column");
+            let a = col.as_slice();
+            for (v, &(xh, xl)) in self.xs.iter().enumerate() {
+                let (mut s, mut c) = ([0.0f64; 4], [0.0f64; 4]);
+                let chunks = m / 4;
+                for j in 0..chunks {
+                    for l in 0..4 {
+                        let i = 4 * j + l;
+                        let p = a[i] * xh[i];
+                        let e = a[i].mul_add(xh[i], -p);
+                        let s2 = s[l] + p;
+                        let bb = s2 - s[l];
+                        let f = (s[l] - (s2 - bb)) + (p - bb);
+                        s[l] = s2;
+                        c[l] += e + f + a[i] * xl[i];
+                    }
+                }
+                let mut tot = Dd::ZERO;
+                for l in 0..4 {
+                    tot = tot + Dd::new(s[l], c[l]);
+                }
+                for i in 4 * chunks..m {
+                    tot = tot + Dd::prod(a[i], xh[i]).add_f64(a[i] * xl[i]);
+                }
+                self.out[v][k] = tot;
+            }
+        }
+    }
 }

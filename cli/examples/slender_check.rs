@@ -199,6 +199,57 @@ fn tracer_only(
     );
 }
 
+/// The tracers alone on identical data: the reference's W, q0, q1 rounded to double,
+/// given to fricont as condensed input and to the reference as they are.
+fn tracers_on_rounded_data(case: &fricont_exchange::io::CaseData, cond: &Condensed) {
+    let m = 2 * cond.p;
+    let w = fricont::faer::Mat::<f64>::from_fn(m, m, |i, j| cond.w[(i, j)]);
+    let problem = fricont::ProblemBuilder::condensed(w)
+        .friction(cond.friction.clone())
+        .gap(cond.gap.clone())
+        .build()
+        .expect("condensed problem");
+    let fc = Condensed::from_double(
+        cond.w.clone(),
+        cond.q0.clone(),
+        cond.q1.clone(),
+        cond.gap.clone(),
+        cond.friction.clone(),
+    );
+    let q0: Vec<f64> = cond.q0.iter().copied().collect();
+    let q1: Vec<f64> = cond.q1.iter().copied().collect();
+    let c = common::reference::compare_with_fricont(
+        &fc,
+        Arc::new(problem),
+        &q0,
+        &q1,
+        case.alpha_start,
+        case.alpha_end,
+        1e-8,
+        &mut |_, _| {},
+    );
+    let want: Vec<Ev> = c
+        .reference
+        .events
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect();
+    let d = differences(&c.fricont, &want, 1e-12);
+    println!(
+        "   both tracers on the reference's W, q rounded to double: {} / {} events, fricont ends {:?}; {} differ by more than 1e-12{}",
+        c.fricont.len(),
+        want.len(),
+        c.fricont_end,
+        d.len(),
+        d.first().map_or(String::new(), |(k, d, e)| format!(
+            ", the most at event {} (node {}, α = {:.14e}): {d:.1e}",
+            k + 1,
+            e.1 + 1,
+            e.0
+        ))
+    );
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     for Spec { name, spec } in parse(&args) {
@@ -315,6 +366,7 @@ fn main() {
         }
         if std::env::var_os("SLENDER_TRACER_ONLY").is_some() {
             tracer_only(&case, &cond, &c.fricont);
+            tracers_on_rounded_data(&case, &cond);
         }
     }
 }

@@ -62,6 +62,7 @@ impl Path {
         let tol = self.tol_at(&pt);
         let table = self.guard_table(&cur.classes, &pt, Some((&cur.t, &cur.rate)));
         let mut best: Option<(f64, Guard)> = None;
+        let mut decreasing = Vec::new();
         let c = self.consts();
         for &GuardRow {
             guard: g,
@@ -75,6 +76,7 @@ impl Path {
             // slowly does cross, and where it crosses first it is the exit.
             if vd < -tol.slope() || (vd < 0.0 && !tol.at_zero(&c.guard_form(g), v, vd)) {
                 let s = (v / -vd).max(0.0);
+                decreasing.push(g);
                 if best.is_none_or(|b| s < b.0) {
                     best = Some((s, g));
                 }
@@ -119,6 +121,10 @@ impl Path {
                 Ok(Exit::Window(Point { lam, ..pt }))
             }
             (Some((s, g)), _) => {
+                if let Some((lam, alpha, g)) = self.polish_exit(cur, &decreasing) {
+                    let pt = self.point_at(lam, alpha)?;
+                    return Ok(Exit::Guards(pt, vec![g]));
+                }
                 let (lam, alpha) = if self.load.is_affine() {
                     // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
                     // piece's factorisation) and τ from the guard's equation; no drift

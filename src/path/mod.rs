@@ -10,6 +10,7 @@
 
 mod advance;
 mod join;
+mod polish;
 mod query;
 mod roots;
 pub(crate) mod update;

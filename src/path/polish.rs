@@ -1,0 +1,250 @@
+//! Transition points of an affine load in double-double (mixed-precision refinement).
+//!
+//! On slender bodies the piece matrices are so ill-conditioned that a transition point
+//! solved in double moves by up to ~1e-7 in α (cond · ε). When the problem carries its
+//! data beyond double ([`crate::Problem::extended_precision`]: W as `W + W_lo`, q as
+//! `q + q_lo`, or exact condensed data), the exit of a straight piece is recomputed from
+//! the data in double-double: the piece's point at its entry α and its rate dλ/dα by
+//! iterative refinement (residuals of the piece equations in double-double, corrections
+//! with the piece's ordinary factorisation, which converges while cond · ε < 1), then
+//! every decreasing guard's zero `α_e + s`, `s = −γ(α_e)/γ'`, in double-double, and the
+//! first one wins. The double-precision ratio test still decides which guards decrease;
+//! only where they cross, and which crosses first, comes from here.
+
+use faer::MatRef;
+
+use super::*;
+use crate::dd::{Dd, sym_gemv_dd};
+use crate::piece::LinForm;
+
+/// Most refinement rounds of one solve.
+const MAX_ROUNDS: usize = 8;
+/// A correction this small relative to the solution ends the refinement.
+const CONVERGED: f64 = 1e-24;
+/// A refinement that stops contracting is kept when its last correction is this small.
+const STALLED: f64 = 1e-20;
+
+/// A vector in double-double, as its high and low parts.
+#[derive(Clone)]
+struct DdVec {
+    hi: Vec<f64>,
+    lo: Vec<f64>,
+}
+
+impl DdVec {
+    fn from(x: &[f64]) -> Self {
+        Self {
+            hi: x.to_vec(),
+            lo: vec![0.0; x.len()],
+        }
+    }
+    fn get(&self, k: usize) -> Dd {
+        Dd {
+            hi: self.hi[k],
+            lo: self.lo[k],
+        }
+    }
+    fn set(&mut self, k: usize, v: Dd) {
+        self.hi[k] = v.hi;
+        self.lo[k] = v.lo;
+    }
+}
+
+/// `d = W x + c` in double-double for each pair `(x, c)`: one pass over W for all of
+/// them (`W_lo x` in double: it is ~ε of `W x`).
+fn gaps_dd(
+    w: MatRef<'_, f64>,
+    w_lo: Option<MatRef<'_, f64>>,
+    pairs: &[(&DdVec, &DdVec)],
+) -> Vec<DdVec> {
+    let xs: Vec<(&[f64], &[f64])> = pairs.iter().map(|(x, _)| (&x.hi[..], &x.lo[..])).collect();
+    let wx = sym_gemv_dd(w, &xs);
+    pairs
+        .iter()
+        .zip(wx)
+        .map(|((x, c), wx)| {
+            let lo = w_lo.map(|wl| mat_vec(wl, &x.hi));
+            let mut d = DdVec::from(&vec![0.0; wx.len()]);
+            for (k, v) in wx.into_iter().enumerate() {
+                let v = match &lo {
+                    Some(l) => v.add_f64(l[k]),
+                    None => v,
+                };
+                d.set(k, v + c.get(k));
+            }
+            d
+        })
+        .collect()
+}
+
+/// `W x` in double (faer).
+fn mat_vec(w: MatRef<'_, f64>, x: &[f64]) -> Vec<f64> {
+    let mut out = faer::Mat::<f64>::zeros(w.nrows(), 1);
+    let xm = faer::MatRef::from_column_major_slice(x, x.len(), 1);
+    faer::linalg::matmul::matmul(
+        out.as_mut(),
+        faer::Accum::Replace,
+        w,
+        xm,
+        1.0,
+        faer::Par::Seq,
+    );
+    out.col(0).iter().copied().collect()
+}
+
+/// `form(λ, d)` in double-double.
+fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
+    let mut v = Dd::ZERO;
+    for t in &f.lam {
+        if t.coef != 0.0 {
+            v = v + lam.get(t.index).mul_f64(t.coef);
+        }
+    }
+    if f.disp.coef != 0.0 {
+        v = v + d.get(f.disp.index).mul_f64(f.disp.coef);
+    }
+    v
+}
+
+impl Path {
+    /// The exit of the straight piece `cur` (affine load, α moving) through the first of
+    /// `decreasing` to reach zero, in double-double: `(λ, α, guard)` rounded to double.
+    /// None when the problem is not carried beyond double, or when the refinement does
+    /// not converge (the piece is too ill-conditioned even for it): the caller then keeps
+    /// its double-precision point.
+    pub(super) fn polish_exit(
+        &mut self,
+        cur: &CurrentPiece,
+        decreasing: &[Guard],
+    ) -> Option<(Vec<f64>, f64, Guard)> {
+        if !self.polishes() || decreasing.is_empty() || cur.scales.is_vertical(&cur.t) {
+            return None;
+        }
+        let m = 2 * self.problem.p();
+        let problem = self.problem.clone();
+        let c = PieceConstants::of(&problem);
+        let del = problem.delassus();
+        // q(α) = q0 + α q1 exactly from its parts (q(0) is q0 itself).
+        let (q0, q1) = self.load.q(0.0, del).ok()?;
+        let (q0_lo, q1_lo) = match self.load.affine_lo() {
+            Some((a, b)) => (a.to_vec(), b.to_vec()),
+            None => (vec![0.0; m], vec![0.0; m]),
+        };
+        let alpha_e = cur.alpha;
+        let gap = problem.gap_equilibrated();
+        let mut c_point = DdVec::from(&vec![0.0; m]);
+        let mut c_rate = DdVec::from(&vec![0.0; m]);
+        for k in 0..m {
+            let mut v = Dd::prod(alpha_e, q1[k]).add_f64(q0[k]);
+            v = v.add_f64(q0_lo[k] + alpha_e * q1_lo[k]);
+            if k < c.p {
+                v = v.add_f64(-gap[k]);
+            }
+            c_point.set(k, v);
+            c_rate.set(k, Dd::new(q1[k], q1_lo[k]));
+        }
+        // M_S solves with the piece's factorisation.
+        let w = del.w();
+        let dense = match &*cur.lu {
+            PieceSolver::Updated(_) => None,
+            PieceSolver::Full(_) => Some(DenseLu::new(c.piece_matrix(w, &cur.classes).as_ref())),
+        };
+        let row_bound = self.row_bound();
+        let msolve = |b: &[f64]| -> Vec<f64> {
+            match (&dense, &*cur.lu) {
+                (Some(lu), _) => lu.solve(b),
+                (None, PieceSolver::Updated(u)) => u.solve_checked(&c, w, b, row_bound).x,
+                (None, PieceSolver::Full(_)) => unreachable!("a full solver has its dense LU"),
+            }
+        };
+        // Refinement of x (λ at α_e, or dλ/dα) from its residual `H(x, d)`: the first
+        // d = W x + c in double-double (one pass over W for both), later ones updated by
+        // W δ in double (δ is small: its rounding is ~ε of δ, far below the target).
+        let refine = |x: &mut DdVec, d: &mut DdVec| -> bool {
+            let mut last = f64::INFINITY;
+            for _ in 0..MAX_ROUNDS {
+                let mut r = vec![0.0; m];
+                for (i, &cls) in cur.classes.iter().enumerate() {
+                    let [nu, t] = c.equations(i, cls);
+                    r[i] = -eval_dd(&nu, x, d).to_f64();
+                    r[c.p + i] = -eval_dd(&t, x, d).to_f64();
+                }
+                let dx = msolve(&r);
+                let size = x.hi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                if !step.is_finite() {
+                    return false;
+                }
+                for (k, v) in dx.iter().enumerate() {
+                    let s = x.get(k).add_f64(*v);
+                    x.set(k, s);
+                }
+                for (k, v) in mat_vec(w, &dx).into_iter().enumerate() {
+                    let s = d.get(k).add_f64(v);
+                    d.set(k, s);
+                }
+                // Converged when this correction, or the next one predicted from the
+                // contraction so far (step² / last), is below the target.
+                if step <= CONVERGED * size || step * (step / last) <= CONVERGED * size {
+                    return true;
+                }
+                // Refinement that stopped contracting has reached what the residual in
+                // double-double can resolve (~cond · ε²): accepted where that is still far
+                // beyond double.
+                if step > 0.5 * last {
+                    return step <= STALLED * size;
+                }
+                last = step;
+            }
+            false
+        };
+        let start = match &cur.xp {
+            Some(xp) => xp.to_vec(),
+            None => cur.lam.clone(),
+        };
+        let ta = cur.t[m];
+        let rate0: Vec<f64> = cur.t[..m].iter().map(|v| v / ta).collect();
+        let (mut lam_e, mut lam_1) = (DdVec::from(&start), DdVec::from(&rate0));
+        let [mut d_e, mut d_1]: [DdVec; 2] =
+            gaps_dd(w, del.w_lo(), &[(&lam_e, &c_point), (&lam_1, &c_rate)])
+                .try_into()
+                .ok()?;
+        if !refine(&mut lam_e, &mut d_e) || !refine(&mut lam_1, &mut d_1) {
+            return None;
+        }
+        let dir = if ta > 0.0 { 1.0 } else { -1.0 };
+        // Every decreasing guard's zero, s = −γ(α_e)/γ' (α − α_e = s, with the sign of
+        // the direction of travel).
+        let mut best: Option<(Dd, Guard)> = None;
+        for &g in decreasing {
+            let f = c.guard_form(g);
+            let v = eval_dd(&f, &lam_e, &d_e);
+            let slope = eval_dd(&f, &lam_1, &d_1);
+            if dir * slope.hi >= 0.0 {
+                continue;
+            }
+            let mut s = (-v).div(slope);
+            if dir * s.hi < 0.0 {
+                s = Dd::ZERO;
+            }
+            if best.is_none_or(|(b, _)| dir * (s - b).hi < 0.0) {
+                best = Some((s, g));
+            }
+        }
+        let (s, g) = best?;
+        let alpha = s.add_f64(alpha_e).to_f64();
+        let (lo, hi) = self.window();
+        if !(lo..=hi).contains(&alpha) {
+            return None;
+        }
+        let lam: Vec<f64> = (0..m)
+            .map(|k| (lam_e.get(k) + lam_1.get(k) * s).to_f64())
+            .collect();
+        (alpha.is_finite() && lam.iter().all(|v| v.is_finite())).then_some((lam, alpha, g))
+    }
+
+    /// True when transition points are computed in double-double (see the module doc).
+    fn polishes(&self) -> bool {
+        self.load.is_affine() && self.problem.extended_precision()
+    }
+}
