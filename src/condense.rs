@@ -807,10 +807,3 @@ fn symmetrise(w: &mut Mat<f64>) {
         }
     }
 }
-
-impl Delassus {
-    /// TEMPORARY stub (replaced by the refinement branch).
-    pub(crate) fn w_lo(&self) -> Option<MatRef<'_, f64>> {
-        None
-    }
-}

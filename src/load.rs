@@ -440,10 +440,3 @@ fn call_vector(f: &mut VectorFn, alpha: f64, out: &mut [f64], what: &str) -> Res
     }
     Ok(())
 }
-
-impl BoundLoad {
-    /// TEMPORARY stub (replaced by the refinement branch).
-    pub(crate) fn affine_lo(&self) -> Option<(&[f64], &[f64])> {
-        None
-    }
-}

@@ -1174,10 +1174,3 @@ impl Problem {
         })
     }
 }
-
-impl Problem {
-    /// TEMPORARY stub (replaced by the refinement branch).
-    pub fn extended_precision(&self) -> bool {
-        std::env::var_os("FRICONT_DD").is_some()
-    }
-}
