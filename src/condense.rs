@@ -30,6 +30,7 @@ use faer::sparse::linalg::cholesky::{
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
+use crate::dd::{Dd, two_prod, two_sum};
 use crate::error::{Error, Result, try_vec, try_zeros};
 use crate::problem::CsrMatrix;
 
@@ -50,8 +51,12 @@ pub struct SetupTimes {
     pub analyse_s: f64,
     /// Numeric Cholesky factorisation of A.
     pub factorise_s: f64,
-    /// Forming W (trailing block or solves) and checking that it is positive definite.
+    /// Forming W (trailing block or solves) and checking that it is positive definite
+    /// (with the estimate of its condition number, [`Delassus::w_condition_estimate`]).
     pub w_s: f64,
+    /// The low part of W by mixed-precision refinement ([`Delassus::w_lo`]); 0 when W
+    /// was not refined ([`crate::ExtendedPrecision`]).
+    pub w_lo_s: f64,
     /// Number of stored values of the factor L.
     pub nnz_l: usize,
 }
@@ -189,6 +194,14 @@ pub struct Delassus {
     /// block: it also turns a back-solve for u into a half solve ([`Self::displacements`]).
     z: Option<Mat<f64>>,
     times: SetupTimes,
+    /// `W_lo`: `W_hi + W_lo` is `B A⁻¹ Bᵀ` to double-double accuracy, `W_hi` = `w` (None:
+    /// not refined, see [`Self::refine_w`]).
+    w_lo: Option<Mat<f64>>,
+    /// The factorised matrix (`h² A`, full storage) kept for refining load vectors when W
+    /// was refined.
+    a_full: Option<CsrMatrix>,
+    /// Estimate of the 2-norm condition number of W ([`Self::w_condition_estimate`]).
+    cond: f64,
 }
 
 impl Delassus {
@@ -301,6 +314,9 @@ impl Delassus {
             w: Mat::zeros(0, 0),
             z: None,
             times: SetupTimes::default(),
+            w_lo: None,
+            a_full: None,
+            cond: f64::NAN,
         };
         this.times.analyse_s = analyse_s;
         this.times.factorise_s = t_factorise.elapsed().as_secs_f64();
@@ -320,7 +336,7 @@ impl Delassus {
             }
             None => this.w_by_solves()?,
         };
-        this.check_w()?;
+        this.cond = this.check_w()?;
         this.times.w_s = t_w.elapsed().as_secs_f64();
         Ok(this)
     }
@@ -427,7 +443,9 @@ impl Delassus {
         Ok(w)
     }
 
-    fn check_w(&self) -> Result<()> {
+    /// Checks W (finite, positive definite with relative pivots above 1e-12) and returns
+    /// the estimate of its condition number from the Cholesky factor it computes.
+    fn check_w(&self) -> Result<f64> {
         let m = self.w.nrows();
         let p = m / 2;
         let name = |i: usize| {
@@ -475,7 +493,7 @@ impl Delassus {
                 return Err(dependent(j, d));
             }
         }
-        Ok(())
+        Ok(condition_estimate(self.w.as_ref(), l.as_ref()))
     }
 
     /// Number of dofs `n` (0 for condensed input).
@@ -733,6 +751,9 @@ impl Delassus {
             w: Mat::zeros(0, 0),
             z: None,
             times: SetupTimes::default(),
+            w_lo: None,
+            a_full: None,
+            cond: f64::NAN,
         };
         let m = b.nrows();
         let block = match &this.op {
@@ -757,15 +778,17 @@ impl Delassus {
         }
         symmetrise(&mut w);
         this.w = w;
-        this.check_w()?;
+        this.cond = this.check_w()?;
         this.times.w_s = t_w.elapsed().as_secs_f64();
         Ok(this)
     }
 
     /// Condensed input: `w` is the caller's W (2p×2p) already divided symmetrically by
     /// the node scales (`row_scale`, 2p entries: node i's scale in rows i and p + i), and
-    /// checked to be symmetric and positive definite by the caller.
-    pub(crate) fn from_condensed(w: Mat<f64>, row_scale: Vec<f64>) -> Self {
+    /// checked to be symmetric and positive definite by the caller, who also gives its
+    /// Cholesky factor `l` (for the condition estimate).
+    pub(crate) fn from_condensed(w: Mat<f64>, row_scale: Vec<f64>, l: MatRef<'_, f64>) -> Self {
+        let cond = condition_estimate(w.as_ref(), l);
         Self {
             n: 0,
             op: Operator::Condensed { row_scale },
@@ -774,6 +797,9 @@ impl Delassus {
             w,
             z: None,
             times: SetupTimes::default(),
+            w_lo: None,
+            a_full: None,
+            cond,
         }
     }
 }
@@ -805,5 +831,316 @@ fn symmetrise(w: &mut Mat<f64>) {
             w[(i, j)] = s;
             w[(j, i)] = s;
         }
+    }
+}
+
+/// Rounds of mixed-precision refinement at most (each gains the digits that κ(A) leaves
+/// of double precision; two or three suffice on the slender meshes of the tests).
+const REFINE_ROUNDS: usize = 5;
+
+/// A correction below this fraction of the solution (∞-norms, column by column) ends the
+/// refinement: the double-double solution is then as accurate as its residuals allow.
+const REFINE_TOL: f64 = 1e-30;
+
+/// Iterations of the power method (λ_max of W) and of inverse iteration (λ_min) in
+/// [`condition_estimate`].
+const COND_ITERS: usize = 20;
+
+impl Delassus {
+    /// The low part of W: `W_hi + W_lo` (with `W_hi` = [`Self::w`]) is `B A⁻¹ Bᵀ` of the
+    /// equilibrated rows to double-double accuracy (about 1e-30 relative to max|W| when A
+    /// is well enough conditioned for refinement in double to converge, κ(A) < 1e15).
+    /// None when W is exact as stored: not refined ([`crate::ExtendedPrecision::Off`], or
+    /// `Auto` on a well-conditioned W, or a host's solve), or condensed input (the caller's
+    /// W is the data).
+    pub fn w_lo(&self) -> Option<MatRef<'_, f64>> {
+        self.w_lo.as_ref().map(|m| m.as_ref())
+    }
+
+    /// An estimate of the 2-norm condition number `λ_max / λ_min` of W (equilibrated
+    /// rows), from 20 steps of the power method for λ_max and 20 steps of inverse
+    /// iteration with the Cholesky factor of W (computed anyway to check that W is
+    /// positive definite) for λ_min: each a lower bound of its eigenvalue's size, so the
+    /// estimate is at most κ₂(W) and usually within a few percent of it. Costs 40 products
+    /// with a 2p × 2p matrix, O(p²) each, at the build. Dimensionless.
+    pub fn w_condition_estimate(&self) -> f64 {
+        self.cond
+    }
+
+    /// Floating-point operations of the numeric Cholesky factorisation of A, estimated as
+    /// `Σ_j c_j²` over the column counts `c_j` of L (0 without fricont's factor).
+    pub(crate) fn factor_flops(&self) -> f64 {
+        let Operator::Cholesky { symbolic, .. } = &self.op else {
+            return 0.0;
+        };
+        match symbolic.raw() {
+            SymbolicCholeskyRaw::Supernodal(sym) => {
+                let (begin, end) = (sym.supernode_begin(), sym.supernode_end());
+                let ptr = sym.col_ptr_for_row_idx();
+                (0..sym.n_supernodes())
+                    .map(|s| {
+                        let k = end[s] - begin[s];
+                        let r = (ptr[s + 1] - ptr[s]) as f64;
+                        (0..k).map(|t| ((k - t) as f64 + r).powi(2)).sum::<f64>()
+                    })
+                    .sum()
+            }
+            SymbolicCholeskyRaw::Simplicial(sym) => sym
+                .col_ptr()
+                .windows(2)
+                .map(|w| ((w[1] - w[0]) as f64).powi(2))
+                .sum(),
+        }
+    }
+
+    /// Floating-point operations of [`Self::refine_w`], estimated for three rounds: per
+    /// column of Bᵀ four solves with the factor (4 nnz(L) each) and three residuals in
+    /// double-double (about 12 operations per entry of A).
+    pub(crate) fn refine_flops(&self, nnz_a: usize) -> f64 {
+        let m = self.w.nrows() as f64;
+        let nnz_l = self.times.nnz_l as f64;
+        m * (4.0 * 4.0 * nnz_l + 3.0 * 12.0 * nnz_a as f64)
+    }
+
+    /// Computes [`Self::w_lo`] by mixed-precision iterative refinement with the Cholesky
+    /// factor of A, in blocks of 32 columns of Bᵀ: `X = A⁻¹ Bᵀ_blk` in double, then
+    /// rounds of `R = Bᵀ_blk − A (X + X_lo)` (double-double, rounded to double),
+    /// `D = A⁻¹ R`, `X + X_lo += D` (double-double) until `‖D‖∞ ≤ 1e-30 ‖X‖∞` in every
+    /// column or a round no longer halves the correction (at most 5 rounds); then
+    /// `W_exact = B (X + X_lo)` in double-double and `W_lo = W_exact − W_hi`, rounded and
+    /// symmetrised. W itself is not changed. `a_full` is the factorised matrix (`h² A`,
+    /// both triangles; [`crate::Problem::a`]); it is kept for [`Self::condense_lo`].
+    /// Memory: O(n · 32) besides W_lo (2p × 2p). Time: about 2p × 4 solves with the
+    /// factor ([`SetupTimes::w_lo_s`]).
+    ///
+    /// Errors: [`Error::InvalidParameter`] for a host's solve (no A to compute residuals
+    /// with); out of memory. A no-op for condensed input.
+    pub(crate) fn refine_w(&mut self, a_full: CsrMatrix) -> Result<()> {
+        match &self.op {
+            Operator::Condensed { .. } => return Ok(()),
+            Operator::Host(_) => return Err(host_cannot_refine()),
+            Operator::Cholesky { .. } => {}
+        }
+        let t = std::time::Instant::now();
+        let (n, m) = (self.n, self.b.nrows());
+        let kb = BLOCK.min(m);
+        let mut w_lo = try_zeros(m, m, "the low part of W")?;
+        let mut buf = RefineBuffers::new(n, kb)?;
+        let mut col0 = 0;
+        while col0 < m {
+            let k = kb.min(m - col0);
+            buf.rhs[..n * k].fill(0.0);
+            for c in 0..k {
+                for (j, v) in self.b.row(col0 + c) {
+                    buf.rhs[c * n + j] = v;
+                }
+            }
+            self.refine_solve(&a_full, &mut buf, k)?;
+            for c in 0..k {
+                let (x, xl) = (&buf.x[c * n..(c + 1) * n], &buf.x_lo[c * n..(c + 1) * n]);
+                for i in 0..m {
+                    let exact = sparse_dot_dd(self.b.row(i), x, xl);
+                    w_lo[(i, col0 + c)] = exact.add_f64(-self.w[(i, col0 + c)]).to_f64();
+                }
+            }
+            col0 += k;
+        }
+        symmetrise(&mut w_lo);
+        self.w_lo = Some(w_lo);
+        self.a_full = Some(a_full);
+        self.times.w_lo_s = t.elapsed().as_secs_f64();
+        Ok(())
+    }
+
+    /// The low parts of condensed load vectors: for each load vector `f_j` (n entries, the
+    /// caller's units) and its condensed image `q_j` as fricont stores it (2p entries),
+    /// `exact((B / h) A⁻¹ f_j) − q_j` rounded to double, by the refinement of
+    /// [`Self::refine_w`] (a few solves per vector). None when W was not refined
+    /// ([`Self::w_lo`] is None): then q is used as stored.
+    /// Errors: lengths that do not match; out of memory.
+    pub fn condense_lo(&self, f: &[&[f64]], q: &[&[f64]]) -> Result<Option<Vec<Vec<f64>>>> {
+        let Some(a_full) = self.a_full.as_ref() else {
+            return Ok(None);
+        };
+        let (n, m) = (self.n, self.b.nrows());
+        if f.len() != q.len() || f.iter().any(|v| v.len() != n) || q.iter().any(|v| v.len() != m) {
+            return Err(Error::Dimension(format!(
+                "condense_lo: {} load vectors of n = {n} entries and {} condensed ones of 2p = {m} entries expected",
+                f.len(),
+                q.len()
+            )));
+        }
+        let mut out = Vec::with_capacity(f.len());
+        let kb = BLOCK.min(f.len().max(1));
+        let mut buf = RefineBuffers::new(n, kb)?;
+        for (fs, qs) in f.chunks(kb).zip(q.chunks(kb)) {
+            let k = fs.len();
+            for (c, v) in fs.iter().enumerate() {
+                // (h² A)⁻¹ (h f): the product by the power of two h is exact.
+                for (r, x) in buf.rhs[c * n..(c + 1) * n].iter_mut().zip(v.iter()) {
+                    *r = self.h * x;
+                }
+            }
+            self.refine_solve(a_full, &mut buf, k)?;
+            for (c, qc) in qs.iter().enumerate() {
+                let (x, xl) = (&buf.x[c * n..(c + 1) * n], &buf.x_lo[c * n..(c + 1) * n]);
+                out.push(
+                    (0..m)
+                        .map(|i| sparse_dot_dd(self.b.row(i), x, xl).add_f64(-qc[i]).to_f64())
+                        .collect(),
+                );
+            }
+        }
+        Ok(Some(out))
+    }
+
+    /// `X + X_lo = A⁻¹ rhs` to double-double accuracy for the first `k` columns of
+    /// `buf.rhs` (n × k, column-major): a solve in double, then rounds of residuals in
+    /// double-double and corrections with the factor (see [`Self::refine_w`]).
+    fn refine_solve(&self, a: &CsrMatrix, buf: &mut RefineBuffers, k: usize) -> Result<()> {
+        let n = self.n;
+        let RefineBuffers { rhs, x, x_lo, r } = buf;
+        let (rhs, x, x_lo, r) = (
+            &rhs[..n * k],
+            &mut x[..n * k],
+            &mut x_lo[..n * k],
+            &mut r[..n * k],
+        );
+        x.copy_from_slice(rhs);
+        self.solve_scaled(MatMut::from_column_major_slice_mut(x, n, k))?;
+        x_lo.fill(0.0);
+        let mut last = vec![f64::INFINITY; k];
+        for _ in 0..REFINE_ROUNDS {
+            for c in 0..k {
+                let (xc, lc) = (&x[c * n..(c + 1) * n], &x_lo[c * n..(c + 1) * n]);
+                for i in 0..n {
+                    // rhs_i − Σ_j a_ij (x_j + x_lo,j), compensated
+                    let (mut s, mut e) = (rhs[c * n + i], 0.0f64);
+                    for (j, v) in a.row(i) {
+                        let (p, pe) = two_prod(-v, xc[j]);
+                        let (s2, se) = two_sum(s, p);
+                        s = s2;
+                        e += pe + se - v * lc[j];
+                    }
+                    r[c * n + i] = s + e;
+                }
+            }
+            self.solve_scaled(MatMut::from_column_major_slice_mut(r, n, k))?;
+            let mut more = false;
+            for c in 0..k {
+                let (mut dn, mut xn) = (0.0f64, 0.0f64);
+                for i in c * n..(c + 1) * n {
+                    let s = Dd {
+                        hi: x[i],
+                        lo: x_lo[i],
+                    }
+                    .add_f64(r[i]);
+                    (x[i], x_lo[i]) = (s.hi, s.lo);
+                    dn = dn.max(r[i].abs());
+                    xn = xn.max(x[i].abs());
+                }
+                if !dn.is_finite() {
+                    return Err(Error::Numerical(
+                        "the refinement of A^-1 B^T diverged (A too ill-conditioned for refinement in double)".into(),
+                    ));
+                }
+                if dn > REFINE_TOL * xn && dn <= 0.5 * last[c] {
+                    more = true;
+                }
+                last[c] = dn;
+            }
+            if !more {
+                break;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The work arrays of [`Delassus::refine_solve`]: right-hand sides, the solution's high and
+/// low parts and the residual, n × block each (column-major).
+struct RefineBuffers {
+    rhs: Vec<f64>,
+    x: Vec<f64>,
+    x_lo: Vec<f64>,
+    r: Vec<f64>,
+}
+
+impl RefineBuffers {
+    fn new(n: usize, k: usize) -> Result<Self> {
+        let what = "the work arrays of the refinement of W";
+        Ok(Self {
+            rhs: try_vec(n * k, 0.0, what)?,
+            x: try_vec(n * k, 0.0, what)?,
+            x_lo: try_vec(n * k, 0.0, what)?,
+            r: try_vec(n * k, 0.0, what)?,
+        })
+    }
+}
+
+/// `Σ v_j (x_j + x_lo,j)` over a sparse row, in double-double (compensated: the products'
+/// and the sums' errors kept; the `v x_lo` terms, already ε times smaller, in double).
+fn sparse_dot_dd(row: impl Iterator<Item = (usize, f64)>, x: &[f64], x_lo: &[f64]) -> Dd {
+    let (mut s, mut e) = (0.0f64, 0.0f64);
+    for (j, v) in row {
+        let (p, pe) = two_prod(v, x[j]);
+        let (s2, se) = two_sum(s, p);
+        s = s2;
+        e += pe + se + v * x_lo[j];
+    }
+    Dd::new(s, e)
+}
+
+pub(crate) fn host_cannot_refine() -> Error {
+    Error::InvalidParameter(
+        "extended precision (W beyond double by mixed-precision refinement) needs A: a problem made with the host's solve cannot be refined (use ProblemBuilder::new with A, or condensed data computed in extended precision)".into(),
+    )
+}
+
+/// An estimate of `κ₂(W) = λ_max / λ_min` for W symmetric positive definite with Cholesky
+/// factor `l` (lower): [`COND_ITERS`] steps of the power method with W and of inverse
+/// iteration with `L Lᵀ`, from a fixed start vector, Rayleigh quotients at the end.
+pub(crate) fn condition_estimate(w: MatRef<'_, f64>, l: MatRef<'_, f64>) -> f64 {
+    let m = w.nrows();
+    if m == 0 {
+        return 1.0;
+    }
+    // A fixed start with no symmetry (a symmetric mesh's extremal eigenvectors may be
+    // orthogonal to a constant vector).
+    let start = Mat::from_fn(m, 1, |i, _| 1.0 + ((i * 7919) % 97) as f64 / 97.0);
+    let normalise = |x: &mut Mat<f64>| {
+        let nrm = x.col(0).norm_l2();
+        if nrm > 0.0 && nrm.is_finite() {
+            *x *= faer::Scale(1.0 / nrm);
+        }
+    };
+    let mut x = start.clone();
+    normalise(&mut x);
+    let mut lmax = 0.0;
+    for _ in 0..COND_ITERS {
+        let y = w * &x;
+        lmax = (x.transpose() * &y)[(0, 0)];
+        x = y;
+        normalise(&mut x);
+    }
+    let mut x = start;
+    normalise(&mut x);
+    let mut inv_lmin = 0.0;
+    for _ in 0..COND_ITERS {
+        let mut y = x.clone();
+        faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, y.as_mut(), Par::Seq);
+        faer::linalg::triangular_solve::solve_upper_triangular_in_place(
+            l.transpose(),
+            y.as_mut(),
+            Par::Seq,
+        );
+        inv_lmin = (x.transpose() * &y)[(0, 0)];
+        x = y;
+        normalise(&mut x);
+    }
+    if inv_lmin > 0.0 && lmax > 0.0 {
+        lmax * inv_lmin
+    } else {
+        f64::INFINITY
     }
 }

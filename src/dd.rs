@@ -5,6 +5,10 @@
 //! piece) is needed beyond double precision: mixed-precision refinement computes residuals
 //! in double-double and corrections with the ordinary double factorisations.
 
+// The condensation uses the error-free transformations; the rest serves the tracer's
+// double-double transition points.
+#![allow(dead_code)]
+
 use std::ops::{Add, Mul, Neg, Sub};
 
 /// `a + b = s + e` exactly (Knuth's two-sum: no assumption on the sizes).

@@ -65,4 +65,4 @@ pub use error::{Error, Result};
 pub use faer;
 pub use load::Load;
 pub use path::{EndReason, Event, Path, PathOptions, PieceRecord, Progress, Solution, StepOutcome};
-pub use problem::{CsrMatrix, Problem, ProblemBuilder, Storage};
+pub use problem::{CsrMatrix, ExtendedPrecision, Problem, ProblemBuilder, Storage};

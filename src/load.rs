@@ -154,6 +154,11 @@ pub(crate) struct BoundLoad {
     load: Load,
     /// Affine: `[q0, q1]`; basis: `q_j`; general: empty.
     q_basis: Vec<Vec<f64>>,
+    /// The low parts of `q_basis` when the problem's W was refined
+    /// ([`Delassus::w_lo`]): `exact(B A⁻¹ f_j) − q_basis[j]`, rounded
+    /// ([`Delassus::condense_lo`]). None otherwise (and for condensed input, whose q is the
+    /// caller's data, and for a general load).
+    q_lo: Option<Vec<Vec<f64>>>,
     /// The same vectors half-solved, `L⁻¹ Pᵀ f_j` (n × k), when the problem has half
     /// solves ([`Delassus::displacements`]): u at an event then costs a backward half only.
     half: Option<faer::Mat<f64>>,
@@ -186,7 +191,7 @@ impl BoundLoad {
         } else {
             0
         };
-        let (q_basis, half) = if del.has_half_solve() && !vectors.is_empty() {
+        let (q_basis, half): (Vec<Vec<f64>>, _) = if del.has_half_solve() && !vectors.is_empty() {
             let n = del.n();
             let mut y = crate::error::try_zeros(n, vectors.len(), "the half-solved load vectors")?;
             for (c, v) in vectors.iter().enumerate() {
@@ -203,14 +208,22 @@ impl BoundLoad {
             (q, Some(y))
         } else {
             let q = vectors
-                .into_iter()
+                .iter()
                 .map(|v| del.condense(v))
                 .collect::<Result<_>>()?;
             (q, None)
         };
+        let q_lo = if vectors.is_empty() {
+            None
+        } else {
+            let f: Vec<&[f64]> = vectors.iter().map(|v| v.as_slice()).collect();
+            let q: Vec<&[f64]> = q_basis.iter().map(|v| v.as_slice()).collect();
+            del.condense_lo(&f, &q)?
+        };
         Ok(Self {
             load,
             q_basis,
+            q_lo,
             half,
             weights: vec![0.0; k],
             dweights: vec![0.0; k],
@@ -241,6 +254,26 @@ impl BoundLoad {
                 })
                 .collect(),
         )
+    }
+
+    /// `(q0_lo, q1_lo)`: the low parts of the condensed affine load `q(α) = q0 + α q1`
+    /// (2p entries each; `q0 + q0_lo` is `B A⁻¹ f0` to double-double accuracy) when the
+    /// problem's W was refined ([`Delassus::w_lo`]). None for other loads or when W was not
+    /// refined.
+    // Used by the tracer's double-double events (another branch) and the tests.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) fn affine_lo(&self) -> Option<(&[f64], &[f64])> {
+        match (&self.load, &self.q_lo) {
+            (Load::Affine { .. }, Some(lo)) => Some((&lo[0], &lo[1])),
+            _ => None,
+        }
+    }
+
+    /// The low parts of the condensed basis vectors (`q_j + q_lo[j]` is `B A⁻¹ f_j` to
+    /// double-double accuracy) of an affine or basis load when the problem's W was refined.
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) fn q_lo(&self) -> Option<&[Vec<f64>]> {
+        self.q_lo.as_deref()
     }
 
     /// True when `f` (hence `q`) is affine in α.
@@ -439,4 +472,54 @@ fn call_vector(f: &mut VectorFn, alpha: f64, out: &mut [f64], what: &str) -> Res
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{CsrMatrix, ExtendedPrecision, ProblemBuilder, Storage};
+
+    /// A 3-dof chain with one contact node on dofs 0 and 1.
+    fn problem(mode: ExtendedPrecision) -> crate::Problem {
+        let a = CsrMatrix::from_dense(3, 3, &[3.0, -1.0, 0.0, -1.0, 3.0, -1.0, 0.0, -1.0, 3.0])
+            .unwrap();
+        let n = CsrMatrix::from_dense(1, 3, &[1.0, 0.0, 0.0]).unwrap();
+        let t = CsrMatrix::from_dense(1, 3, &[0.0, 1.0, 0.0]).unwrap();
+        ProblemBuilder::new(a, Storage::Full, n, t)
+            .extended_precision(mode)
+            .build()
+            .unwrap()
+    }
+
+    /// The low parts of an affine load are those of `Delassus::condense_lo` for the stored
+    /// `q0`, `q1`, and exist only when W was refined.
+    #[test]
+    fn affine_low_parts_follow_the_refinement() {
+        let (f0, f1) = (vec![0.1, 0.7, 1.0 / 3.0], vec![1.0, -0.3, 0.2]);
+        let on = problem(ExtendedPrecision::On);
+        let del = on.delassus();
+        let bl = BoundLoad::new(Load::affine(f0.clone(), f1.clone()).unwrap(), del).unwrap();
+        let (lo0, lo1) = bl.affine_lo().expect("refined");
+        let want = del
+            .condense_lo(&[&f0, &f1], &[&bl.q_basis[0], &bl.q_basis[1]])
+            .unwrap()
+            .unwrap();
+        assert_eq!((lo0, lo1), (want[0].as_slice(), want[1].as_slice()));
+        assert_eq!(bl.q_lo().map(|q| q.len()), Some(2));
+        // A basis load has low parts but no affine ones.
+        let basis = Load::basis(
+            vec![f0.clone()],
+            Box::new(|_, w, d| {
+                w[0] = 1.0;
+                d[0] = 0.0;
+                Ok(())
+            }),
+        )
+        .unwrap();
+        let bl = BoundLoad::new(basis, del).unwrap();
+        assert!(bl.affine_lo().is_none() && bl.q_lo().is_some());
+        let off = problem(ExtendedPrecision::Off);
+        let bl = BoundLoad::new(Load::affine(f0, f1).unwrap(), off.delassus()).unwrap();
+        assert!(bl.affine_lo().is_none() && bl.q_lo().is_none());
+    }
 }

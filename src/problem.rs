@@ -352,6 +352,48 @@ pub enum Storage {
     Upper,
 }
 
+/// Whether W and the condensed loads are carried beyond double precision
+/// ([`ProblemBuilder::extended_precision`]).
+///
+/// On slender bodies (thin strips, beams) the Delassus operator W is so ill-conditioned
+/// that W merely rounded to double moves transition points by up to ~1e-7 in α (the
+/// p = 480 strip of `cli/benches/strips.rs`). With extended precision fricont computes
+/// the low parts `W_lo` and `q_lo` of `W = W_hi + W_lo` and `q = q_hi + q_lo` by
+/// mixed-precision iterative refinement with its Cholesky factor of A (residuals in
+/// double-double, corrections in double), and the tracer locates transition points in
+/// double-double. `W_hi` and `q_hi` are exactly what they are without it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ExtendedPrecision {
+    /// Refine when W is ill-conditioned and refining is affordable: the estimate
+    /// [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e7) and the
+    /// refinement's estimated floating-point operations (about `2p · (16 nnz(L) + 36
+    /// nnz(A))`) are at most `max(20 × the factorisation's, 2e10)` (a few seconds on one
+    /// core). A host's solve is never refined; condensed input counts as extended when its
+    /// W is ill-conditioned (the tracer then works in double-double with the caller's W).
+    #[default]
+    Auto,
+    /// Always refine (condensed input: always trace in double-double). A host's solve is
+    /// an error ([`Error::InvalidParameter`]): without A there is no residual to refine
+    /// with.
+    On,
+    /// Never: W and q as rounded to double.
+    Off,
+}
+
+/// [`ExtendedPrecision::Auto`] refines W when the estimate of its 2-norm condition number
+/// exceeds this (equilibrated rows): there, W's rounding to double (relative 1e-16 entry by
+/// entry) moves the solutions of the piece equations by more than about 1e-9.
+pub const AUTO_CONDITION: f64 = 1e7;
+
+/// [`ExtendedPrecision::Auto`] refines only when the refinement's estimated floating-point
+/// operations are at most `max(AUTO_COST_RATIO × the factorisation's, AUTO_COST_FLOPS)`.
+pub const AUTO_COST_RATIO: f64 = 20.0;
+
+/// The absolute budget of [`ExtendedPrecision::Auto`] in floating-point operations (2e10,
+/// a few seconds on one core), see [`AUTO_COST_RATIO`]: slender strips factorise in
+/// almost no time, but their refinement (a few solves per column of Bᵀ) stays small.
+pub const AUTO_COST_FLOPS: f64 = 2e10;
+
 /// Where the operator `A⁻¹` and `W` come from.
 #[derive(Debug, Clone)]
 enum Source {
@@ -387,6 +429,7 @@ pub struct ProblemBuilder {
     gap: Option<Vec<f64>>,
     r: Option<f64>,
     threads: usize,
+    extended: ExtendedPrecision,
 }
 
 impl ProblemBuilder {
@@ -431,7 +474,19 @@ impl ProblemBuilder {
             gap: None,
             r: None,
             threads: 1,
+            extended: ExtendedPrecision::Auto,
         }
+    }
+
+    /// Whether W and the condensed loads are carried beyond double precision (see
+    /// [`ExtendedPrecision`]); default [`ExtendedPrecision::Auto`]. Refining costs about
+    /// four solves with the factor of A per column of Bᵀ (2p columns) at the build, and
+    /// 2p × 2p more numbers of memory (W_lo); the time is [`crate::condense::SetupTimes::w_lo_s`].
+    /// With [`ExtendedPrecision::On`], [`ProblemBuilder::build`] fails with
+    /// [`Error::InvalidParameter`] for a problem made with a host's solve.
+    pub fn extended_precision(mut self, mode: ExtendedPrecision) -> Self {
+        self.extended = mode;
+        self
     }
 
     /// The number of threads of the set-up (the numeric Cholesky factorisation of A and
@@ -584,6 +639,10 @@ impl ProblemBuilder {
                 "r = {r}, must be finite and > 0"
             )));
         }
+        if self.extended == ExtendedPrecision::On && matches!(self.source, Source::Solve { .. }) {
+            return Err(crate::condense::host_cannot_refine());
+        }
+        let mode = self.extended;
         let (a, b, node_scale, delassus, a_scale_log2) = match self.source {
             Source::Matrix {
                 mut a,
@@ -609,7 +668,20 @@ impl ProblemBuilder {
                 a.scale_pow2(k);
                 let (lower, full_a) = lower_and_full(&a, storage, k)?;
                 let h = mul_pow2(1.0, k / 2);
-                let del = with_threads(self.threads, |par| Delassus::new(&lower, &b_unit, h, par))?;
+                let mut del =
+                    with_threads(self.threads, |par| Delassus::new(&lower, &b_unit, h, par))?;
+                let refine = match mode {
+                    ExtendedPrecision::On => true,
+                    ExtendedPrecision::Off => false,
+                    ExtendedPrecision::Auto => {
+                        del.w_condition_estimate() > AUTO_CONDITION
+                            && del.refine_flops(full_a.nnz())
+                                <= (AUTO_COST_RATIO * del.factor_flops()).max(AUTO_COST_FLOPS)
+                    }
+                };
+                if refine {
+                    del.refine_w(full_a.clone())?;
+                }
                 let mut b = b_unit;
                 b.scale_pow2(-k / 2);
                 let node_scale = unit_scale.iter().map(|s| s * h).collect();
@@ -621,13 +693,20 @@ impl ProblemBuilder {
                 (None, b, node_scale, del, 0)
             }
             Source::Condensed { w } => {
-                let (w_int, node_scale) = equilibrated_w(w)?;
+                let (w_int, node_scale, l) = equilibrated_w(w)?;
                 let row_scale = (0..2 * p).map(|k| node_scale[k % p]).collect();
-                let del = Delassus::from_condensed(w_int, row_scale);
+                let del = Delassus::from_condensed(w_int, row_scale, l.as_ref());
                 (None, del.b().clone(), node_scale, del, 0)
             }
         };
         let gap_eq: Vec<f64> = gap.iter().zip(&node_scale).map(|(g, s)| g / s).collect();
+        let extended = delassus.w_lo().is_some()
+            || (delassus.is_condensed()
+                && match mode {
+                    ExtendedPrecision::On => true,
+                    ExtendedPrecision::Off => false,
+                    ExtendedPrecision::Auto => delassus.w_condition_estimate() > AUTO_CONDITION,
+                });
         let delassus = std::sync::Arc::new(delassus);
         let r_default = delassus.default_r();
         let r = self.r.unwrap_or(r_default);
@@ -653,6 +732,7 @@ impl ProblemBuilder {
             r_default,
             w_row_sums,
             delassus,
+            extended,
         })
     }
 }
@@ -773,8 +853,8 @@ fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMat
 /// relative pivot above 1e-12) and equilibrates it as [`equilibrated_b`] would the rows of
 /// B: `s_i` the power of two at or below `sqrt(max(W_ii, W_{p+i,p+i}))` (node i's rows of
 /// B in the A⁻¹ norm), so the internal W has node diagonals < 4 and keeps the caller's
-/// digits. Returns `S⁻¹ W S⁻¹` and the scales.
-fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
+/// digits. Returns `S⁻¹ W S⁻¹`, the scales and the Cholesky factor of `S⁻¹ W S⁻¹`.
+fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>, Mat<f64>)> {
     let m = w.nrows();
     let p = m / 2;
     let name = |i: usize| {
@@ -852,7 +932,7 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>)> {
             return Err(pivot_err(j, d));
         }
     }
-    Ok((w_int, node_scale))
+    Ok((w_int, node_scale, l))
 }
 
 /// Lower triangle (row ≥ col) and full storage of A, checking the storage convention and,
@@ -1067,6 +1147,8 @@ pub struct Problem {
     /// The absolute row sums of W (equilibrated rows).
     w_row_sums: std::sync::Arc<Vec<f64>>,
     delassus: std::sync::Arc<Delassus>,
+    /// See [`Problem::extended_precision`].
+    extended: bool,
 }
 
 impl Problem {
@@ -1153,6 +1235,21 @@ impl Problem {
     pub fn delassus(&self) -> &Delassus {
         &self.delassus
     }
+    /// True when W is carried beyond double precision (see [`ExtendedPrecision`]): W was
+    /// refined (`W_hi + W_lo`, [`Delassus::w_lo`]; the loads' condensed vectors are then
+    /// refined too), or the problem was made from condensed data with
+    /// [`ExtendedPrecision::On`], or with `Auto` and an ill-conditioned W (the caller's W
+    /// and q are exact data). The tracer then locates transition points in double-double.
+    pub fn extended_precision(&self) -> bool {
+        self.extended
+    }
+    /// An estimate of the 2-norm condition number of the equilibrated W (dimensionless, a
+    /// lower bound that is usually within a few percent; see
+    /// [`Delassus::w_condition_estimate`]). Computed at every build (O(p²) on top of the
+    /// Cholesky factorisation of W that checks it).
+    pub fn w_condition_estimate(&self) -> f64 {
+        self.delassus.w_condition_estimate()
+    }
     /// A copy of this problem with another `r`; the factor of A and W are shared, not
     /// recomputed. Errors: r ≤ 0 or not finite, `r / default_r()` outside [`R_RANGE`].
     pub fn with_r(&self, r: f64) -> Result<Problem> {
@@ -1171,6 +1268,7 @@ impl Problem {
             r_default: self.r_default,
             w_row_sums: self.w_row_sums.clone(),
             delassus: self.delassus.clone(),
+            extended: self.extended,
         })
     }
 }
