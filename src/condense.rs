@@ -847,7 +847,8 @@ const REFINE_TOL: f64 = 1e-30;
 const COND_ITERS: usize = 20;
 
 impl Delassus {
-    /// The low part of W: `W_hi + W_lo` (with `W_hi` = [`Self::w`]) is `B A⁻¹ Bᵀ` of the
+    /// The low part of W: `W_hi + W_lo` (with `W_hi` = [`Self::w`], then W correctly
+    /// rounded) is `B A⁻¹ Bᵀ` of the
     /// equilibrated rows to double-double accuracy (about 1e-30 relative to max|W| when A
     /// is well enough conditioned for refinement in double to converge, κ(A) < 1e15).
     /// None when W is exact as stored: not refined ([`crate::ExtendedPrecision::Off`], or
@@ -907,8 +908,9 @@ impl Delassus {
     /// rounds of `R = Bᵀ_blk − A (X + X_lo)` (double-double, rounded to double),
     /// `D = A⁻¹ R`, `X + X_lo += D` (double-double) until `‖D‖∞ ≤ 1e-30 ‖X‖∞` in every
     /// column or a round no longer halves the correction (at most 5 rounds); then
-    /// `W_exact = B (X + X_lo)` in double-double and `W_lo = W_exact − W_hi`, rounded and
-    /// symmetrised. W itself is not changed. `a_full` is the factorised matrix (`h² A`,
+    /// `W_exact = B (X + X_lo)` in double-double, symmetrised; W becomes `W_exact` rounded
+    /// to double (the W of the trailing block or of the solves is accurate only to
+    /// ~κ(A) ε) and `W_lo` the rest. `a_full` is the factorised matrix (`h² A`,
     /// both triangles; [`crate::Problem::a`]); it is kept for [`Self::condense_lo`].
     /// Memory: O(n · 32) besides W_lo (2p × 2p). Time: about 2p × 4 solves with the
     /// factor ([`SetupTimes::w_lo_s`]).
@@ -925,6 +927,7 @@ impl Delassus {
         let (n, m) = (self.n, self.b.nrows());
         let kb = BLOCK.min(m);
         let mut w_lo = try_zeros(m, m, "the low part of W")?;
+        let mut w_hi = try_zeros(m, m, "W rounded from double-double")?;
         let mut buf = RefineBuffers::new(n, kb)?;
         let mut col0 = 0;
         while col0 < m {
@@ -940,12 +943,24 @@ impl Delassus {
                 let (x, xl) = (&buf.x[c * n..(c + 1) * n], &buf.x_lo[c * n..(c + 1) * n]);
                 for i in 0..m {
                     let exact = sparse_dot_dd(self.b.row(i), x, xl);
-                    w_lo[(i, col0 + c)] = exact.add_f64(-self.w[(i, col0 + c)]).to_f64();
+                    (w_hi[(i, col0 + c)], w_lo[(i, col0 + c)]) = (exact.hi, exact.lo);
                 }
             }
             col0 += k;
         }
-        symmetrise(&mut w_lo);
+        // The exact W is symmetric; its two computed halves differ in the last digits of
+        // double-double. Their mean, rounded: W_hi (W correctly rounded, which every
+        // double-precision computation of the tracer then uses) and W_lo.
+        for j in 0..m {
+            for i in j..m {
+                let mean = (Dd::new(w_hi[(i, j)], w_lo[(i, j)])
+                    + Dd::new(w_hi[(j, i)], w_lo[(j, i)]))
+                .mul_f64(0.5);
+                (w_hi[(i, j)], w_lo[(i, j)]) = (mean.hi, mean.lo);
+                (w_hi[(j, i)], w_lo[(j, i)]) = (mean.hi, mean.lo);
+            }
+        }
+        self.w = w_hi;
         self.w_lo = Some(w_lo);
         self.a_full = Some(a_full);
         self.times.w_lo_s = t.elapsed().as_secs_f64();

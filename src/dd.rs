@@ -147,57 +147,6 @@ pub(crate) fn dot_dd(a: &[f64], x_hi: &[f64], x_lo: &[f64]) -> Dd {
     Dd::new(s, c)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn exact_transformations() {
-        // 1 + 2^-60 is not a double; its parts are kept.
-        let (s, e) = two_sum(1.0, 2f64.powi(-60));
-        assert_eq!((s, e), (1.0, 2f64.powi(-60)));
-        // (1 + 2^-30)^2 = 1 + 2^-29 + 2^-60
-        let x = 1.0 + 2f64.powi(-30);
-        let (p, e) = two_prod(x, x);
-        assert_eq!(p, 1.0 + 2f64.powi(-29));
-        assert_eq!(e, 2f64.powi(-60));
-    }
-
-    #[test]
-    fn division_and_dot_beyond_double() {
-        // 1/3 in double-double: 3 · (1/3) − 1 vanishes to ~1e-32.
-        let third = Dd::from(1.0).div(Dd::from(3.0));
-        let back = third.mul_f64(3.0) - Dd::from(1.0);
-        assert!(back.to_f64().abs() < 1e-31, "{back:?}");
-        // A cancelling dot product: 1e16 + 1 − 1e16 = 1 (double gives 0 or 2).
-        let d = dot_dd(&[1e16, 1.0, -1e16], &[1.0, 1.0, 1.0], &[0.0; 3]);
-        assert_eq!(d.to_f64(), 1.0);
-        // The low parts count: x = 1 + 2^-70 as (1, 2^-70), 2^70 x − 2^70 = 1.
-        let t70 = 2f64.powi(70);
-        let d = dot_dd(&[t70, -t70], &[1.0, 1.0], &[2f64.powi(-70), 0.0]);
-        assert_eq!(d.to_f64(), 1.0);
-    }
-
-    #[test]
-    fn symmetric_products_agree_with_the_scalar_dot() {
-        // A symmetric W of mixed sizes (m = 11: two lanes' chunks and a remainder).
-        let m = 11;
-        let w = faer::Mat::<f64>::from_fn(m, m, |i, j| {
-            let (a, b) = (i.min(j) as f64, i.max(j) as f64);
-            (1.0 + a * 0.37 + b * 1.3).sin() * 10f64.powi(((a + b) as i32 % 7) - 3)
-        });
-        let xh: Vec<f64> = (0..m).map(|i| (i as f64 * 0.9).cos() * 1e3).collect();
-        let xl: Vec<f64> = xh.iter().map(|v| v * 1e-17).collect();
-        let got = sym_gemv_dd(w.as_ref(), &[(&xh, &xl)]);
-        for k in 0..m {
-            let col: Vec<f64> = (0..m).map(|i| w[(i, k)]).collect();
-            let want = dot_dd(&col, &xh, &xl);
-            let d = (got[0][k] - want).to_f64().abs();
-            assert!(d <= 1e-30 * want.to_f64().abs().max(1.0), "row {k}: {d:e}");
-        }
-    }
-}
-
 /// `W x` in double-double for the symmetric `W` (m × m, column-major, each column
 /// contiguous) and each double-double vector `x = x_hi + x_lo` of `xs`: row k is read as
 /// column k, and every dot product runs in four independent lanes (compensated), compiled
@@ -251,6 +200,57 @@ impl faer::traits::pulp::WithSimd for GemvDd<'_> {
                 }
                 self.out[v][k] = tot;
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exact_transformations() {
+        // 1 + 2^-60 is not a double; its parts are kept.
+        let (s, e) = two_sum(1.0, 2f64.powi(-60));
+        assert_eq!((s, e), (1.0, 2f64.powi(-60)));
+        // (1 + 2^-30)^2 = 1 + 2^-29 + 2^-60
+        let x = 1.0 + 2f64.powi(-30);
+        let (p, e) = two_prod(x, x);
+        assert_eq!(p, 1.0 + 2f64.powi(-29));
+        assert_eq!(e, 2f64.powi(-60));
+    }
+
+    #[test]
+    fn division_and_dot_beyond_double() {
+        // 1/3 in double-double: 3 · (1/3) − 1 vanishes to ~1e-32.
+        let third = Dd::from(1.0).div(Dd::from(3.0));
+        let back = third.mul_f64(3.0) - Dd::from(1.0);
+        assert!(back.to_f64().abs() < 1e-31, "{back:?}");
+        // A cancelling dot product: 1e16 + 1 − 1e16 = 1 (double gives 0 or 2).
+        let d = dot_dd(&[1e16, 1.0, -1e16], &[1.0, 1.0, 1.0], &[0.0; 3]);
+        assert_eq!(d.to_f64(), 1.0);
+        // The low parts count: x = 1 + 2^-70 as (1, 2^-70), 2^70 x − 2^70 = 1.
+        let t70 = 2f64.powi(70);
+        let d = dot_dd(&[t70, -t70], &[1.0, 1.0], &[2f64.powi(-70), 0.0]);
+        assert_eq!(d.to_f64(), 1.0);
+    }
+
+    #[test]
+    fn symmetric_products_agree_with_the_scalar_dot() {
+        // A symmetric W of mixed sizes (m = 11: two lanes' chunks and a remainder).
+        let m = 11;
+        let w = faer::Mat::<f64>::from_fn(m, m, |i, j| {
+            let (a, b) = (i.min(j) as f64, i.max(j) as f64);
+            (1.0 + a * 0.37 + b * 1.3).sin() * 10f64.powi(((a + b) as i32 % 7) - 3)
+        });
+        let xh: Vec<f64> = (0..m).map(|i| (i as f64 * 0.9).cos() * 1e3).collect();
+        let xl: Vec<f64> = xh.iter().map(|v| v * 1e-17).collect();
+        let got = sym_gemv_dd(w.as_ref(), &[(&xh, &xl)]);
+        for k in 0..m {
+            let col: Vec<f64> = (0..m).map(|i| w[(i, k)]).collect();
+            let want = dot_dd(&col, &xh, &xl);
+            let d = (got[0][k] - want).to_f64().abs();
+            assert!(d <= 1e-30 * want.to_f64().abs().max(1.0), "row {k}: {d:e}");
         }
     }
 }

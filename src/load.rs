@@ -213,13 +213,23 @@ impl BoundLoad {
                 .collect::<Result<_>>()?;
             (q, None)
         };
-        let q_lo = if vectors.is_empty() {
+        let mut q_lo = if vectors.is_empty() {
             None
         } else {
             let f: Vec<&[f64]> = vectors.iter().map(|v| v.as_slice()).collect();
             let q: Vec<&[f64]> = q_basis.iter().map(|v| v.as_slice()).collect();
             del.condense_lo(&f, &q)?
         };
+        // With low parts, q_j becomes B A⁻¹ f_j correctly rounded (the stored q_j is
+        // accurate only to ~κ(A) ε), and its low part the rest.
+        let mut q_basis = q_basis;
+        if let Some(lo) = &mut q_lo {
+            for (q, l) in q_basis.iter_mut().zip(lo.iter_mut()) {
+                for (a, b) in q.iter_mut().zip(l.iter_mut()) {
+                    (*a, *b) = crate::dd::two_sum(*a, *b);
+                }
+            }
+        }
         Ok(Self {
             load,
             q_basis,
@@ -491,8 +501,9 @@ mod tests {
             .unwrap()
     }
 
-    /// The low parts of an affine load are those of `Delassus::condense_lo` for the stored
-    /// `q0`, `q1`, and exist only when W was refined.
+    /// The low parts of an affine load complete the stored `q0`, `q1` to `B A⁻¹ f`
+    /// (`Delassus::condense_lo` finds nothing else missing), and exist only when W was
+    /// refined.
     #[test]
     fn affine_low_parts_follow_the_refinement() {
         let (f0, f1) = (vec![0.1, 0.7, 1.0 / 3.0], vec![1.0, -0.3, 0.2]);
@@ -504,7 +515,19 @@ mod tests {
             .condense_lo(&[&f0, &f1], &[&bl.q_basis[0], &bl.q_basis[1]])
             .unwrap()
             .unwrap();
-        assert_eq!((lo0, lo1), (want[0].as_slice(), want[1].as_slice()));
+        // q_j + q_lo,j is B A⁻¹ f_j (what condense_lo finds missing from q_j is q_lo,j, to
+        // double-double accuracy), and q_j is it correctly rounded (|q_lo| ≤ half an ulp).
+        for (lo, (want, q)) in [lo0, lo1].into_iter().zip(want.iter().zip(&bl.q_basis)) {
+            for k in 0..lo.len() {
+                assert!(
+                    (lo[k] - want[k]).abs() <= 1e-28 * q[k].abs(),
+                    "{} {}",
+                    lo[k],
+                    want[k]
+                );
+                assert!(lo[k].abs() <= 0.5 * f64::EPSILON * q[k].abs() * (1.0 + 1e-12));
+            }
+        }
         assert_eq!(bl.q_lo().map(|q| q.len()), Some(2));
         // A basis load has low parts but no affine ones.
         let basis = Load::basis(

@@ -361,7 +361,7 @@ pub enum Storage {
 /// the low parts `W_lo` and `q_lo` of `W = W_hi + W_lo` and `q = q_hi + q_lo` by
 /// mixed-precision iterative refinement with its Cholesky factor of A (residuals in
 /// double-double, corrections in double), and the tracer locates transition points in
-/// double-double. `W_hi` and `q_hi` are exactly what they are without it.
+/// double-double. `W_hi` and `q_hi` are then W and q correctly rounded to double.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ExtendedPrecision {
     /// Refine when W is ill-conditioned and refining is affordable: the estimate

@@ -329,15 +329,9 @@ fn beam_48_by_1_p120_friction_1() {
 }
 
 /// The thin strip of `cli/benches/strips.rs` with p = 240 (241 × 4 nodes on
-/// (0, 6) × (0, 0.1), aspect ratio 60), the whole window. About 10 s in release: a fresh
-/// double-double-refined LU for each of its 479 pieces.
-///
-/// Not yet to the 1e-8: the same 479 transitions, but two α differ by 2.3e-8 and
-/// 1.5e-8 (stick -> slip+ at the strip's ends; 16 events by up to 3.4e-7 on the p = 480
-/// strip, `slender_check strip 480`). One unit in the last place of A moves them by
-/// ~1e-16: the error is fricont's double-precision W and piece solves, whose errors grow
-/// with the condition of W on slender strips, against the reference's double-double
-/// condensation. Checked here to 1e-7 so that it cannot get worse unseen.
+/// (0, 6) × (0, 0.1), aspect ratio 60), the whole window, to the 1e-8. Extended
+/// precision (Auto: κ(W) is above 1e7) carries W and q in double-double and polishes each
+/// transition point; in double alone two α differed by 2.3e-8 and 1.5e-8.
 #[test]
 fn strip_p240() {
     slender(
@@ -349,6 +343,58 @@ fn strip_p240() {
             ly: 0.1,
             ..RectSpec::press_shear()
         },
-        1e-7,
+        1e-8,
     );
+}
+
+/// The tracer alone on data exact in double: the reference's condensation of the beam
+/// rounded to double is given to fricont as condensed input (extended precision on: its
+/// transition points are polished in double-double) and to the reference as it is. Both
+/// then trace the same problem, and must agree to 1e-12 (fricont's transition points
+/// solved in double alone differ from the reference's by up to ~1e-8 on the p = 240
+/// strip: cond(M_S) · ε).
+#[test]
+fn tracer_in_double_double_on_exact_condensed_data() {
+    for friction in [0.3, 1.0] {
+        let case = generate(&beam(friction)).expect("generate");
+        let cond = condensed(&case);
+        let exact = Condensed::from_double(
+            cond.w.clone(),
+            cond.q0.clone(),
+            cond.q1.clone(),
+            cond.gap.clone(),
+            cond.friction.clone(),
+        );
+        let m = 2 * cond.p;
+        let problem =
+            fricont::ProblemBuilder::condensed(fricont::faer::Mat::from_fn(m, m, |i, j| {
+                cond.w[(i, j)]
+            }))
+            .friction(cond.friction.clone())
+            .gap(cond.gap.clone())
+            .extended_precision(fricont::ExtendedPrecision::On)
+            .build()
+            .expect("condensed problem");
+        assert!(problem.extended_precision());
+        let q0: Vec<f64> = cond.q0.iter().copied().collect();
+        let q1: Vec<f64> = cond.q1.iter().copied().collect();
+        let c = compare_with_fricont(
+            &exact,
+            Arc::new(problem),
+            &q0,
+            &q1,
+            case.alpha_start,
+            case.alpha_end,
+            1e-12,
+            &mut no_progress(),
+        );
+        if let Err(e) = c.check(1e-12) {
+            panic!(
+                "F = {friction}: fricont {} events, reference {} events: {e}",
+                c.fricont.len(),
+                c.reference.events.len()
+            );
+        }
+        assert!(c.fricont.len() >= 50, "only {} events", c.fricont.len());
+    }
 }
