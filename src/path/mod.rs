@@ -1159,7 +1159,14 @@ impl Path {
     /// alpha_end).
     fn begin(&mut self, pt: &Point, cand: Candidate, want: i8) -> Result<()> {
         let alpha = pt.alpha;
-        let pt = pt.clone();
+        let mut pt = pt.clone();
+        // On a graph piece of a problem carried beyond double, the start point too is
+        // refined in double-double (from the fixed-α solve's point).
+        if !cand.scales.is_vertical(&cand.t)
+            && let Some(lam) = self.polish_point(&cand.classes, &cand.lu, alpha, &pt.lam)
+        {
+            pt.lam = lam;
+        }
         self.commit_solver(&cand.lu);
         let start = self.state(&pt.lam, alpha, &cand.classes)?;
         let dir = cand.direction();

@@ -106,7 +106,162 @@ fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
     v
 }
 
+/// What a refinement on one piece needs: the constants, W (both parts), the load's
+/// parts in double-double, and the piece's solves.
+struct Refiner<'a> {
+    c: PieceConstants<'a>,
+    w: MatRef<'a, f64>,
+    w_lo: Option<MatRef<'a, f64>>,
+    classes: &'a [Class],
+    solve: Box<dyn Fn(&[f64]) -> Vec<f64> + 'a>,
+    /// q0 and q1 (high, low) of the affine load.
+    q: [(Vec<f64>, Vec<f64>); 2],
+    gap: &'a [f64],
+}
+
+impl Refiner<'_> {
+    /// The constant of d at α: `q0 + α q1 − (g, 0)` in double-double.
+    fn point_constant(&self, alpha: f64) -> DdVec {
+        let m = self.w.nrows();
+        let [(q0, q0_lo), (q1, q1_lo)] = &self.q;
+        let mut out = DdVec::from(&vec![0.0; m]);
+        for k in 0..m {
+            let mut v = Dd::prod(alpha, q1[k]).add_f64(q0[k]);
+            v = v.add_f64(q0_lo[k] + alpha * q1_lo[k]);
+            if k < self.c.p {
+                v = v.add_f64(-self.gap[k]);
+            }
+            out.set(k, v);
+        }
+        out
+    }
+
+    /// The constant of d's rate: `q1` in double-double.
+    fn rate_constant(&self) -> DdVec {
+        let (q1, q1_lo) = &self.q[1];
+        DdVec {
+            hi: q1.clone(),
+            lo: q1_lo.clone(),
+        }
+    }
+
+    /// Refines x (λ at an α, or dλ/dα) with `d = W x + c` from the residual `H(x, d)` of
+    /// the piece equations in double-double and corrections by the piece's solves; d is
+    /// kept up to date by `W δ` in double (δ is small: its rounding is ~ε of δ, far below
+    /// the target). False when it does not converge.
+    fn refine(&self, x: &mut DdVec, d: &mut DdVec) -> bool {
+        let (c, m) = (&self.c, self.w.nrows());
+        let mut last = f64::INFINITY;
+        for _ in 0..MAX_ROUNDS {
+            let mut r = vec![0.0; m];
+            for (i, &cls) in self.classes.iter().enumerate() {
+                let [nu, t] = c.equations(i, cls);
+                r[i] = -eval_dd(&nu, x, d).to_f64();
+                r[c.p + i] = -eval_dd(&t, x, d).to_f64();
+            }
+            let dx = (self.solve)(&r);
+            let size = x.hi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            if !step.is_finite() {
+                return false;
+            }
+            for (k, v) in dx.iter().enumerate() {
+                let s = x.get(k).add_f64(*v);
+                x.set(k, s);
+            }
+            for (k, v) in mat_vec(self.w, &dx).into_iter().enumerate() {
+                let s = d.get(k).add_f64(v);
+                d.set(k, s);
+            }
+            // Converged when this correction, or the next one predicted from the
+            // contraction so far (step² / last), is below the target.
+            if step <= CONVERGED * size || step * (step / last) <= CONVERGED * size {
+                return true;
+            }
+            // Refinement that stopped contracting has reached what the residual in
+            // double-double can resolve (~cond · ε²): accepted where that is still far
+            // beyond double.
+            if step > 0.5 * last {
+                return step <= STALLED * size;
+            }
+            last = step;
+        }
+        false
+    }
+
+    /// Refines each `(x, c)` pair from its double-precision guess: `(x, W x + c)`.
+    fn refine_all(&self, pairs: Vec<(DdVec, DdVec)>) -> Option<Vec<(DdVec, DdVec)>> {
+        let refs: Vec<(&DdVec, &DdVec)> = pairs.iter().map(|(x, c)| (x, c)).collect();
+        let ds = gaps_dd(self.w, self.w_lo, &refs);
+        pairs
+            .into_iter()
+            .zip(ds)
+            .map(|((mut x, _), mut d)| self.refine(&mut x, &mut d).then_some((x, d)))
+            .collect()
+    }
+}
+
 impl Path {
+    /// The [`Refiner`] of the piece `classes` solved by `lu`; None when the problem is not
+    /// carried beyond double (see the module doc).
+    fn refiner<'a>(
+        &mut self,
+        problem: &'a Problem,
+        classes: &'a [Class],
+        lu: &'a PieceSolver,
+    ) -> Option<Refiner<'a>> {
+        if !self.polishes() {
+            return None;
+        }
+        let m = 2 * problem.p();
+        let c = PieceConstants::of(problem);
+        let del = problem.delassus();
+        // q(α) = q0 + α q1 exactly from its parts (q(0) is q0 itself).
+        let (q0, q1) = self.load.q(0.0, del).ok()?;
+        let (q0_lo, q1_lo) = match self.load.affine_lo() {
+            Some((a, b)) => (a.to_vec(), b.to_vec()),
+            None => (vec![0.0; m], vec![0.0; m]),
+        };
+        let w = del.w();
+        let row_bound = self.row_bound();
+        let solve: Box<dyn Fn(&[f64]) -> Vec<f64> + 'a> = match lu {
+            PieceSolver::Updated(u) => {
+                Box::new(move |b: &[f64]| u.solve_checked(&c, w, b, row_bound).x)
+            }
+            PieceSolver::Full(_) => {
+                let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
+                Box::new(move |b: &[f64]| lu.solve(b))
+            }
+        };
+        Some(Refiner {
+            c,
+            w,
+            w_lo: del.w_lo(),
+            classes,
+            solve,
+            q: [(q0, q0_lo), (q1, q1_lo)],
+            gap: problem.gap_equilibrated(),
+        })
+    }
+
+    /// λ on the graph piece `classes` (solved by `lu`) at α, refined in double-double
+    /// from the guess `lam` and rounded: the start point. None as for [`Self::refiner`],
+    /// or when the refinement does not converge.
+    pub(super) fn polish_point(
+        &mut self,
+        classes: &[Class],
+        lu: &PieceSolver,
+        alpha: f64,
+        lam: &[f64],
+    ) -> Option<Vec<f64>> {
+        let problem = self.problem.clone();
+        let r = self.refiner(&problem, classes, lu)?;
+        let c = r.point_constant(alpha);
+        let (x, _) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
+        let out: Vec<f64> = (0..x.hi.len()).map(|k| x.get(k).to_f64()).collect();
+        out.iter().all(|v| v.is_finite()).then_some(out)
+    }
+
     /// The exit of the straight piece `cur` (affine load, α moving) through the first of
     /// `decreasing` to reach zero, in double-double: `(λ, α, guard)` rounded to double.
     /// None when the problem is not carried beyond double, or when the refinement does
@@ -117,101 +272,28 @@ impl Path {
         cur: &CurrentPiece,
         decreasing: &[Guard],
     ) -> Option<(Vec<f64>, f64, Guard)> {
-        if !self.polishes() || decreasing.is_empty() || cur.scales.is_vertical(&cur.t) {
+        if decreasing.is_empty() || cur.scales.is_vertical(&cur.t) {
             return None;
         }
         let m = 2 * self.problem.p();
         let problem = self.problem.clone();
-        let c = PieceConstants::of(&problem);
-        let del = problem.delassus();
-        // q(α) = q0 + α q1 exactly from its parts (q(0) is q0 itself).
-        let (q0, q1) = self.load.q(0.0, del).ok()?;
-        let (q0_lo, q1_lo) = match self.load.affine_lo() {
-            Some((a, b)) => (a.to_vec(), b.to_vec()),
-            None => (vec![0.0; m], vec![0.0; m]),
-        };
+        let r = self.refiner(&problem, &cur.classes, &cur.lu)?;
+        let c = &r.c;
         let alpha_e = cur.alpha;
-        let gap = problem.gap_equilibrated();
-        let mut c_point = DdVec::from(&vec![0.0; m]);
-        let mut c_rate = DdVec::from(&vec![0.0; m]);
-        for k in 0..m {
-            let mut v = Dd::prod(alpha_e, q1[k]).add_f64(q0[k]);
-            v = v.add_f64(q0_lo[k] + alpha_e * q1_lo[k]);
-            if k < c.p {
-                v = v.add_f64(-gap[k]);
-            }
-            c_point.set(k, v);
-            c_rate.set(k, Dd::new(q1[k], q1_lo[k]));
-        }
-        // M_S solves with the piece's factorisation.
-        let w = del.w();
-        let dense = match &*cur.lu {
-            PieceSolver::Updated(_) => None,
-            PieceSolver::Full(_) => Some(DenseLu::new(c.piece_matrix(w, &cur.classes).as_ref())),
-        };
-        let row_bound = self.row_bound();
-        let msolve = |b: &[f64]| -> Vec<f64> {
-            match (&dense, &*cur.lu) {
-                (Some(lu), _) => lu.solve(b),
-                (None, PieceSolver::Updated(u)) => u.solve_checked(&c, w, b, row_bound).x,
-                (None, PieceSolver::Full(_)) => unreachable!("a full solver has its dense LU"),
-            }
-        };
-        // Refinement of x (λ at α_e, or dλ/dα) from its residual `H(x, d)`: the first
-        // d = W x + c in double-double (one pass over W for both), later ones updated by
-        // W δ in double (δ is small: its rounding is ~ε of δ, far below the target).
-        let refine = |x: &mut DdVec, d: &mut DdVec| -> bool {
-            let mut last = f64::INFINITY;
-            for _ in 0..MAX_ROUNDS {
-                let mut r = vec![0.0; m];
-                for (i, &cls) in cur.classes.iter().enumerate() {
-                    let [nu, t] = c.equations(i, cls);
-                    r[i] = -eval_dd(&nu, x, d).to_f64();
-                    r[c.p + i] = -eval_dd(&t, x, d).to_f64();
-                }
-                let dx = msolve(&r);
-                let size = x.hi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-                let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-                if !step.is_finite() {
-                    return false;
-                }
-                for (k, v) in dx.iter().enumerate() {
-                    let s = x.get(k).add_f64(*v);
-                    x.set(k, s);
-                }
-                for (k, v) in mat_vec(w, &dx).into_iter().enumerate() {
-                    let s = d.get(k).add_f64(v);
-                    d.set(k, s);
-                }
-                // Converged when this correction, or the next one predicted from the
-                // contraction so far (step² / last), is below the target.
-                if step <= CONVERGED * size || step * (step / last) <= CONVERGED * size {
-                    return true;
-                }
-                // Refinement that stopped contracting has reached what the residual in
-                // double-double can resolve (~cond · ε²): accepted where that is still far
-                // beyond double.
-                if step > 0.5 * last {
-                    return step <= STALLED * size;
-                }
-                last = step;
-            }
-            false
-        };
         let start = match &cur.xp {
             Some(xp) => xp.to_vec(),
             None => cur.lam.clone(),
         };
         let ta = cur.t[m];
         let rate0: Vec<f64> = cur.t[..m].iter().map(|v| v / ta).collect();
-        let (mut lam_e, mut lam_1) = (DdVec::from(&start), DdVec::from(&rate0));
-        let [mut d_e, mut d_1]: [DdVec; 2] =
-            gaps_dd(w, del.w_lo(), &[(&lam_e, &c_point), (&lam_1, &c_rate)])
-                .try_into()
-                .ok()?;
-        if !refine(&mut lam_e, &mut d_e) || !refine(&mut lam_1, &mut d_1) {
-            return None;
-        }
+        let mut refined = r
+            .refine_all(vec![
+                (DdVec::from(&start), r.point_constant(alpha_e)),
+                (DdVec::from(&rate0), r.rate_constant()),
+            ])?
+            .into_iter();
+        let (lam_e, d_e) = refined.next()?;
+        let (lam_1, d_1) = refined.next()?;
         let dir = if ta > 0.0 { 1.0 } else { -1.0 };
         // Every decreasing guard's zero, s = −γ(α_e)/γ' (α − α_e = s, with the sign of
         // the direction of travel).
