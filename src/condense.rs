@@ -199,7 +199,7 @@ pub struct Delassus {
     w_lo: Option<Mat<f64>>,
     /// The factorised matrix (`h² A`, full storage) kept for refining load vectors when W
     /// was refined.
-    a_full: Option<CsrMatrix>,
+    a_full: Option<std::sync::Arc<CsrMatrix>>,
     /// Estimate of the 2-norm condition number of W ([`Self::w_condition_estimate`]).
     cond: f64,
 }
@@ -912,13 +912,14 @@ impl Delassus {
     /// strips, where ρ ≈ 1e-7); then
     /// `W_exact = B (X + X_lo)` in double-double and `W_lo = W_exact − W_hi`, rounded and
     /// symmetrised. W itself is not changed. `a_full` is the factorised matrix (`h² A`,
-    /// both triangles; [`crate::Problem::a`]); it is kept for [`Self::condense_lo`].
+    /// both triangles; [`crate::Problem::a`], shared with the problem, not copied); it is
+    /// kept for [`Self::condense_lo`].
     /// Memory: O(n · 32) besides W_lo (2p × 2p). Time: about 2p × 4 solves with the
     /// factor ([`SetupTimes::w_lo_s`]).
     ///
     /// Errors: [`Error::InvalidParameter`] for a host's solve (no A to compute residuals
     /// with); out of memory. A no-op for condensed input.
-    pub(crate) fn refine_w(&mut self, a_full: CsrMatrix) -> Result<()> {
+    pub(crate) fn refine_w(&mut self, a_full: std::sync::Arc<CsrMatrix>) -> Result<()> {
         match &self.op {
             Operator::Condensed { .. } => return Ok(()),
             Operator::Host(_) => return Err(host_cannot_refine()),

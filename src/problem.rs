@@ -670,6 +670,7 @@ impl ProblemBuilder {
                 let k = stiffness_exponent(a.max_abs(), &unit_scale);
                 a.scale_pow2(k);
                 let (lower, full_a) = lower_and_full(&a, storage, k)?;
+                let full_a = std::sync::Arc::new(full_a);
                 let h = mul_pow2(1.0, k / 2);
                 let mut del =
                     with_threads(self.threads, |par| Delassus::new(&lower, &b_unit, h, par))?;
@@ -1136,7 +1137,7 @@ fn check_r(r: f64, r_default: f64) -> Result<()> {
 pub struct Problem {
     n: usize,
     p: usize,
-    a: Option<CsrMatrix>,
+    a: Option<std::sync::Arc<CsrMatrix>>,
     b: CsrMatrix,
     friction: Vec<f64>,
     /// The gap as given.
@@ -1182,7 +1183,7 @@ impl Problem {
     /// numbers unless A's largest entry lies outside `[2^-64, 2^64]`); None when the
     /// problem was made from a host's solve or from condensed data.
     pub fn a(&self) -> Option<&CsrMatrix> {
-        self.a.as_ref()
+        self.a.as_deref()
     }
     /// The exponent k of the exact internal scaling `2^k A` (even; 0 unless A's largest
     /// entry lies outside `[2^-64, 2^64]`, then the k that brings it into `[1, 4)`).
