@@ -54,6 +54,7 @@ build start_branches $C "${WARN[@]}" c-tests/start_branches.c c-tests/common.c -
 build csr_input $C "${WARN[@]}" c-tests/csr_input.c c-tests/common.c -o "$OUT/csr_input" "${LINK[@]}" -lm
 build oom $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" c-tests/oom.c c-tests/common.c -o "$OUT/oom" "${LINK[@]}" -lm
 build scales $C "${WARN[@]}" c-tests/scales.c c-tests/common.c -o "$OUT/scales" "${LINK[@]}" -lm
+build extended_precision $C "${WARN[@]}" c-tests/extended_precision.c c-tests/common.c -o "$OUT/extended_precision" "${LINK[@]}" -lm
 build q1_rectangle $C "${WARN[@]}" examples-c/q1_rectangle.c -o "$OUT/q1_rectangle" "${LINK[@]}" -lm
 # The same programs with AddressSanitizer + UndefinedBehaviorSanitizer, against the same
 # (uninstrumented) release libfricont.so: every access the C side makes to what fricont
@@ -68,6 +69,7 @@ build asan_status $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" "${SAN[@]}" c-tests/
 build asan_paths $C -D_POSIX_C_SOURCE=200809L "${WARN[@]}" "${SAN[@]}" c-tests/paths.c c-tests/common.c -o "$ASAN_OUT/paths" "${LINK[@]}" -lm -lpthread
 build asan_cholmod_ref $C -I/usr/include/suitesparse "${WARN[@]}" "${SAN[@]}" c-tests/cholmod_ref.c c-tests/common.c -o "$ASAN_OUT/cholmod_ref" "${LINK[@]}" -lcholmod -lm
 build asan_scales $C "${WARN[@]}" "${SAN[@]}" c-tests/scales.c c-tests/common.c -o "$ASAN_OUT/scales" "${LINK[@]}" -lm
+build asan_extended_precision $C "${WARN[@]}" "${SAN[@]}" c-tests/extended_precision.c c-tests/common.c -o "$ASAN_OUT/extended_precision" "${LINK[@]}" -lm
 build asan_q1_rectangle $C "${WARN[@]}" "${SAN[@]}" examples-c/q1_rectangle.c -o "$ASAN_OUT/q1_rectangle" "${LINK[@]}" -lm
 # The threads test with ThreadSanitizer (see the TSan section below).
 TSAN_OUT="$OUT/tsan"
@@ -155,6 +157,7 @@ run "loads and threads: Q1 example" "$OUT/paths" "$Q1"
 run "branches at the start: vertex-start" "$OUT/start_branches" "$CASES/vertex-start"
 if [ -f "$SAMPLE/meta.json" ]; then
     run "extreme scales of A: sample" "$OUT/scales" "$SAMPLE"
+    run "extended precision: sample, tiny, host, condensed" "$OUT/extended_precision" "$SAMPLE"
 fi
 run "CHOLMOD reference: Q1 example, via condensed" "$OUT/cholmod_ref" "$Q1" --F 1.2 --via condensed
 run "CHOLMOD reference: Q1 example, via solve, 1-based" "$OUT/cholmod_ref" "$Q1" --F 1.2 --via solve --base 1
@@ -182,6 +185,7 @@ if [ -f "$SAMPLE/meta.json" ]; then
     run "asan+ubsan CHOLMOD reference: sample, threads 2" "${SANENV[@]}" "$ASAN_OUT/cholmod_ref" "$SAMPLE" --threads 2
     run "asan+ubsan loads and threads: sample" "${SANENV[@]}" "$ASAN_OUT/paths" "$SAMPLE"
     run "asan+ubsan extreme scales of A: sample" "${SANENV[@]}" "$ASAN_OUT/scales" "$SAMPLE"
+    run "asan+ubsan extended precision" "${SANENV[@]}" "$ASAN_OUT/extended_precision" "$SAMPLE"
 fi
 
 # --- ThreadSanitizer ---------------------------------------------------------------------------

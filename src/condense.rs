@@ -199,7 +199,7 @@ pub struct Delassus {
     w_lo: Option<Mat<f64>>,
     /// The factorised matrix (`h² A`, full storage) kept for refining load vectors when W
     /// was refined.
-    a_full: Option<CsrMatrix>,
+    a_full: Option<std::sync::Arc<CsrMatrix>>,
     /// Estimate of the 2-norm condition number of W ([`Self::w_condition_estimate`]).
     cond: f64,
 }
@@ -906,18 +906,21 @@ impl Delassus {
     /// Computes [`Self::w_lo`] by mixed-precision iterative refinement with the Cholesky
     /// factor of A, in blocks of 32 columns of Bᵀ: `X = A⁻¹ Bᵀ_blk` in double, then
     /// rounds of `R = Bᵀ_blk − A (X + X_lo)` (double-double, rounded to double),
-    /// `D = A⁻¹ R`, `X + X_lo += D` (double-double) until `‖D‖∞ ≤ 1e-30 ‖X‖∞` in every
-    /// column or a round no longer halves the correction (at most 5 rounds); then
-    /// `W_exact = B (X + X_lo)` in double-double, symmetrised; W becomes `W_exact` rounded
-    /// to double (the W of the trailing block or of the solves is accurate only to
-    /// ~κ(A) ε) and `W_lo` the rest. `a_full` is the factorised matrix (`h² A`,
-    /// both triangles; [`crate::Problem::a`]); it is kept for [`Self::condense_lo`].
+    /// `D = A⁻¹ R`, `X + X_lo += D` (double-double) until, in every column, `‖D‖∞ ≤
+    /// 1e-30 ‖X‖∞`, or a round no longer halves the correction, or the next correction
+    /// (the contraction ρ ≈ κ(A) ε of the last round times ‖D‖) falls below the floor
+    /// `ρ ε ‖X‖` that residuals in double-double allow (at most 5 rounds; 3 on the slender
+    /// strips, where ρ ≈ 1e-7); then `W_exact = B (X + X_lo)` in double-double,
+    /// symmetrised; W becomes `W_exact` rounded to double (the W of the trailing block or
+    /// of the solves is accurate only to ~κ(A) ε) and `W_lo` the rest. `a_full` is the
+    /// factorised matrix (`h² A`, both triangles; [`crate::Problem::a`], shared with the
+    /// problem, not copied); it is kept for [`Self::condense_lo`].
     /// Memory: O(n · 32) besides W_lo (2p × 2p). Time: about 2p × 4 solves with the
     /// factor ([`SetupTimes::w_lo_s`]).
     ///
     /// Errors: [`Error::InvalidParameter`] for a host's solve (no A to compute residuals
     /// with); out of memory. A no-op for condensed input.
-    pub(crate) fn refine_w(&mut self, a_full: CsrMatrix) -> Result<()> {
+    pub(crate) fn refine_w(&mut self, a_full: std::sync::Arc<CsrMatrix>) -> Result<()> {
         match &self.op {
             Operator::Condensed { .. } => return Ok(()),
             Operator::Host(_) => return Err(host_cannot_refine()),
@@ -1059,7 +1062,20 @@ impl Delassus {
                         "the refinement of A^-1 B^T diverged (A too ill-conditioned for refinement in double)".into(),
                     ));
                 }
-                if dn > REFINE_TOL * xn && dn <= 0.5 * last[c] {
+                // The contraction ρ ≈ κ(A) ε of a round (the first correction is ρ times
+                // x). The residuals, exact to ~ε² |A| |x|, leave a floor of ~ρ ε ‖x‖
+                // that no round passes: once the next correction, ρ ‖D‖, is below it (or
+                // below the tolerance), or a round no longer halves the correction, the
+                // column is done.
+                let rho = if last[c].is_finite() {
+                    dn / last[c]
+                } else {
+                    dn / xn
+                };
+                if dn > REFINE_TOL * xn
+                    && dn <= 0.5 * last[c]
+                    && rho * dn > (REFINE_TOL).max(rho * f64::EPSILON / 2.0) * xn
+                {
                     more = true;
                 }
                 last[c] = dn;

@@ -367,8 +367,8 @@ pub enum ExtendedPrecision {
     /// Refine when W is ill-conditioned and refining is affordable: the estimate
     /// [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e7) and the
     /// refinement's estimated floating-point operations (about `2p · (16 nnz(L) + 36
-    /// nnz(A))`) are at most `max(20 × the factorisation's, 2e10)` (a few seconds on one
-    /// core). A host's solve is never refined; condensed input counts as extended when its
+    /// nnz(A))`) are at most `max(20 × the factorisation's, 5e10)` ([`AUTO_COST_FLOPS`]:
+    /// about 5 s on one core). A host's solve is never refined; condensed input counts as extended when its
     /// W is ill-conditioned (the tracer then works in double-double with the caller's W).
     #[default]
     Auto,
@@ -389,10 +389,13 @@ pub const AUTO_CONDITION: f64 = 1e7;
 /// operations are at most `max(AUTO_COST_RATIO × the factorisation's, AUTO_COST_FLOPS)`.
 pub const AUTO_COST_RATIO: f64 = 20.0;
 
-/// The absolute budget of [`ExtendedPrecision::Auto`] in floating-point operations (2e10,
-/// a few seconds on one core), see [`AUTO_COST_RATIO`]: slender strips factorise in
-/// almost no time, but their refinement (a few solves per column of Bᵀ) stays small.
-pub const AUTO_COST_FLOPS: f64 = 2e10;
+/// The absolute budget of [`ExtendedPrecision::Auto`] in floating-point operations (5e10,
+/// about 5 s on one core), see [`AUTO_COST_RATIO`]. Slender strips factorise in almost no
+/// time, so the ratio alone would refuse them, while their refinement stays within the
+/// time of tracing them: the p = 480 strip of `cli/benches/strips.rs` (estimate 4e10)
+/// refines in about 4 s and traces in about 8 s. A 308,160-dof mesh with p = 480 would
+/// need 8e11 (44 × its factorisation).
+pub const AUTO_COST_FLOPS: f64 = 5e10;
 
 /// Where the operator `A⁻¹` and `W` come from.
 #[derive(Debug, Clone)]
@@ -667,6 +670,7 @@ impl ProblemBuilder {
                 let k = stiffness_exponent(a.max_abs(), &unit_scale);
                 a.scale_pow2(k);
                 let (lower, full_a) = lower_and_full(&a, storage, k)?;
+                let full_a = std::sync::Arc::new(full_a);
                 let h = mul_pow2(1.0, k / 2);
                 let mut del =
                     with_threads(self.threads, |par| Delassus::new(&lower, &b_unit, h, par))?;
@@ -1133,7 +1137,7 @@ fn check_r(r: f64, r_default: f64) -> Result<()> {
 pub struct Problem {
     n: usize,
     p: usize,
-    a: Option<CsrMatrix>,
+    a: Option<std::sync::Arc<CsrMatrix>>,
     b: CsrMatrix,
     friction: Vec<f64>,
     /// The gap as given.
@@ -1179,7 +1183,7 @@ impl Problem {
     /// numbers unless A's largest entry lies outside `[2^-64, 2^64]`); None when the
     /// problem was made from a host's solve or from condensed data.
     pub fn a(&self) -> Option<&CsrMatrix> {
-        self.a.as_ref()
+        self.a.as_deref()
     }
     /// The exponent k of the exact internal scaling `2^k A` (even; 0 unless A's largest
     /// entry lies outside `[2^-64, 2^64]`, then the k that brings it into `[1, 4)`).

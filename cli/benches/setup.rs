@@ -3,11 +3,13 @@
 //! ```text
 //! cargo bench --bench setup                 # generated: 481 × 321 rectangle, 1201 × 4 strip
 //! cargo bench --bench setup -- DIR [DIR…]   # problem directories in the exchange format
+//! FRICONT_BENCH_EXTENDED=on cargo bench --bench setup -- DIR   # extended precision on|off (default auto)
 //! ```
 //!
 //! For each case it prints the time to read the files, the symbolic analysis (fill-reducing
 //! ordering with the contact dofs last), the numeric Cholesky factorisation of A, forming
-//! W (from the trailing block of the factor, or by 2p solves for wide rows), the condensed
+//! W (from the trailing block of the factor, or by 2p solves for wide rows), the estimate
+//! of its condition number and whether it was refined (extended precision), the condensed
 //! load vectors q (one solve each), nnz(L), and the peak resident memory of the process
 //! (VmHWM). `benches-c/cholmod_setup_time.c` times CHOLMOD on the same A.mtx for
 //! comparison (README, Benchmarks).
@@ -16,6 +18,7 @@ use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+use fricont::ExtendedPrecision;
 use fricont::path::{Path, PathOptions};
 use fricont_exchange::generator::{RectSpec, generate};
 use fricont_exchange::io::CaseData;
@@ -56,7 +59,12 @@ fn bench(dir: &FsPath) {
     };
     let read_s = t.elapsed().as_secs_f64();
     let t = Instant::now();
-    let problem = match case.problem(None) {
+    let mode = match std::env::var("FRICONT_BENCH_EXTENDED").as_deref() {
+        Ok("on") => ExtendedPrecision::On,
+        Ok("off") => ExtendedPrecision::Off,
+        _ => ExtendedPrecision::Auto,
+    };
+    let problem = match case.builder().extended_precision(mode).build() {
         Ok(p) => Arc::new(p),
         Err(e) => {
             eprintln!("bench setup: {}: {e}", dir.display());
@@ -94,6 +102,20 @@ fn bench(dir: &FsPath) {
         times.factorise_s,
         times.w_s,
         peak_mib().unwrap_or(f64::NAN)
+    );
+    println!(
+        "  W: condition estimate {:.3e}, extended precision {}{}",
+        problem.w_condition_estimate(),
+        if problem.extended_precision() {
+            "on"
+        } else {
+            "off"
+        },
+        if problem.delassus().w_lo().is_some() {
+            format!(" (W_lo by refinement {:.3} s)", times.w_lo_s)
+        } else {
+            String::new()
+        }
     );
 }
 

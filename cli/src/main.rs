@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! fricont trace DIR [--alpha-start A] [--alpha-end B] [--r R] [--max-steps K] [--threads N]
-//!                   [--json FILE] [--progress]
+//!                   [--extended-precision auto|on|off] [--json FILE] [--progress]
 //! ```
 //!
 //! reads a problem directory in the exchange format (`docs/exchange-format.md`), traces
@@ -128,6 +128,11 @@ struct TraceArgs {
     /// with one thread to rounding; tracing runs on one thread.
     #[arg(long, default_value_t = 1)]
     threads: usize,
+    /// Carry W and the condensed loads beyond double precision (mixed-precision
+    /// refinement with the factor of A, for slender bodies whose W is ill-conditioned):
+    /// auto when the condition estimate of W exceeds 1e7 and the cost is moderate.
+    #[arg(long, value_enum, default_value_t = Extended::Auto)]
+    extended_precision: Extended,
     /// Write the JSON report to this file (every key: docs/json-report.md). The file is
     /// checked to be writable before anything is read or traced.
     #[arg(long)]
@@ -137,6 +142,14 @@ struct TraceArgs {
     /// anyway.
     #[arg(long)]
     progress: bool,
+}
+
+/// `--extended-precision`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+enum Extended {
+    Auto,
+    On,
+    Off,
 }
 
 /// A failure with its exit status.
@@ -313,13 +326,27 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
         case.p()
     ));
     let t0 = Instant::now();
-    let mut builder = case.builder().threads(args.threads);
+    let mut builder =
+        case.builder()
+            .threads(args.threads)
+            .extended_precision(match args.extended_precision {
+                Extended::Auto => fricont::ExtendedPrecision::Auto,
+                Extended::On => fricont::ExtendedPrecision::On,
+                Extended::Off => fricont::ExtendedPrecision::Off,
+            });
     if let Some(r) = args.r {
         builder = builder.r(r);
     }
     let problem = builder
         .build()
         .map_err(|e| input(format!("{}: {e}", args.dir.display())))?;
+    if problem.extended_precision() {
+        eprintln!(
+            "fricont: note: extended precision: W (condition estimate {:.1e}) refined beyond double in {:.2} s",
+            problem.w_condition_estimate(),
+            problem.delassus().setup_times().w_lo_s
+        );
+    }
     let load = case
         .load()
         .map_err(|e| input(format!("{}: {e}", args.dir.display())))?;

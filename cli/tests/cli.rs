@@ -943,6 +943,8 @@ fn bad_options_exit_2() {
         vec!["trace", dir, "--r", "abc"],
         vec!["trace", dir, "--threads", "0"],
         vec!["trace", dir, "--threads", "4096"],
+        vec!["trace", dir, "--extended-precision", "maybe"],
+        vec!["trace", dir, "--extended-precision", "1"],
         vec!["trace", dir, "--alpha-start", "2", "--alpha-end", "2"],
         vec!["trace"],
         vec!["frobnicate"],
@@ -998,6 +1000,44 @@ fn sample_runs_through_the_cli() {
         assert_eq!(e.node as u64 + 1, j["node"].as_u64().unwrap());
         assert_eq!(e.from.name(), j["from"].as_str().unwrap());
         assert_eq!(e.to.name(), j["to"].as_str().unwrap());
+    }
+    // Extended precision on (the sample's W is well conditioned: auto leaves it off):
+    // the same transitions, α to rounding; stderr says so, and only then.
+    let out_dir = TempDir::new("ext");
+    let json_path = out_dir.path().join("out.json");
+    let dir = sample_dir();
+    let o = run(&[
+        "trace",
+        dir.to_str().unwrap(),
+        "--extended-precision",
+        "on",
+        "--json",
+        json_path.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("extended precision: W (condition estimate"),
+        "{}",
+        stderr(&o)
+    );
+    let ext: Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    let (a, b) = (event_list(&v), event_list(&ext));
+    assert_eq!(a.len(), b.len());
+    for (x, y) in a.iter().zip(&b) {
+        assert!(
+            (x.0 - y.0).abs() <= 1e-12 * x.0.abs().max(1.0)
+                && (x.1, &x.2, &x.3) == (y.1, &y.2, &y.3),
+            "{x:?} {y:?}"
+        );
+    }
+    for mode in ["auto", "off"] {
+        let o = run(&["trace", dir.to_str().unwrap(), "--extended-precision", mode]);
+        assert!(o.status.success(), "{}", stderr(&o));
+        assert!(
+            !stderr(&o).contains("extended precision"),
+            "{mode}: {}",
+            stderr(&o)
+        );
     }
     // The set-up on 2 threads: the same transitions, α to rounding.
     let (t2, _) = trace_json(&sample_dir(), &["--threads", "2"]);

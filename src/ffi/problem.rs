@@ -860,6 +860,85 @@ pub unsafe extern "C" fn fricont_problem_set_threads(
     })
 }
 
+/// Sets whether W and the condensed loads are carried beyond double precision
+/// (`ProblemBuilder::extended_precision` of the Rust API): `mode` 0 = auto (the default),
+/// 1 = on, 2 = off. On slender bodies (thin strips, beams) W = B A⁻¹ Bᵀ is so
+/// ill-conditioned that W rounded to double moves transition points by up to ~1e-7 in α;
+/// with extended precision fricont also computes the low parts of W and of the condensed
+/// load vectors by mixed-precision iterative refinement with its Cholesky factor of A
+/// (residuals in double-double, about four solves with the factor per column of Bᵀ at
+/// the build, and 2p × 2p more doubles of memory). Auto refines when an estimate of the
+/// 2-norm condition number of the equilibrated W exceeds 1e7 and the refinement's
+/// estimated cost is at most max(20 × the factorisation's, 5e10 floating-point
+/// operations); off never. A problem made from condensed data (`fricont_problem_new_condensed`)
+/// is never refined (its W is the caller's data); with on (or auto and an ill-conditioned
+/// W) it is traced in extended precision all the same. Like the friction, a change drops
+/// the factorisation: the next build (explicit or by `fricont_path_new_*`) factorises A
+/// again; existing paths are not affected. Query the outcome with
+/// `fricont_problem_extended_precision`.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (`mode` not
+/// 0, 1 or 2; the setting is then unchanged), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// With mode 1 on a problem made with a host's solve (`fricont_problem_new_solve`), the
+/// build fails with `FRICONT_ERR_RANGE`: without A there is nothing to refine with.
+///
+/// # Safety
+/// `problem` is NULL or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_set_extended_precision(
+    problem: *mut fricont_problem,
+    mode: i32,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        let m = match mode {
+            0 => crate::ExtendedPrecision::Auto,
+            1 => crate::ExtendedPrecision::On,
+            2 => crate::ExtendedPrecision::Off,
+            _ => {
+                return Err(Failure::range(format!(
+                    "extended precision mode = {mode}, must be 0 (auto), 1 (on) or 2 (off)"
+                )));
+            }
+        };
+        h.lock().update(|b| b.extended_precision(m));
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// Whether the problem is traced in extended precision (`*extended` = 1, else 0: W was
+/// refined beyond double, or condensed data with mode on or auto and an ill-conditioned W;
+/// see `fricont_problem_set_extended_precision`) and the estimate of the 2-norm condition
+/// number of the equilibrated W (`*w_condition`, dimensionless; a lower bound usually
+/// within a few percent, from 20 power and 20 inverse iterations). Builds the problem if
+/// needed (so it returns the build's errors too). Each output pointer may be NULL.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), the errors of
+/// `fricont_problem_build`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `problem` is NULL or a live handle; `extended`, `w_condition` are NULL or valid for
+/// one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_problem_extended_precision(
+    problem: *mut fricont_problem,
+    extended: *mut i32,
+    w_condition: *mut f64,
+) -> fricont_status {
+    ffi_boundary!(problem => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(problem, "problem") }?;
+        let (pr, _, _) = h.shared()?;
+        // SAFETY: NULL or valid, by contract.
+        unsafe {
+            put(extended, i32::from(pr.extended_precision()));
+            put(w_condition, pr.w_condition_estimate());
+        }
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
 /// Validates and factorises the problem now: checks the symmetry of A (full storage),
 /// computes a sparse Cholesky factorisation of A (the dofs B touches ordered last) and the
 /// Delassus operator W = B A⁻¹ Bᵀ from the trailing block of the factor (or by 2p solves
