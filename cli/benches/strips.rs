@@ -4,6 +4,7 @@
 //! cargo bench --bench strips                  # p = 240, 480, 960, 1920
 //! cargo bench --bench strips -- 240 480       # chosen sizes
 //! FRICONT_BENCH_FRESH=480 cargo bench --bench strips   # also fresh factorisations up to p = 480
+//! FRICONT_BENCH_EXTENDED=on cargo bench --bench strips -- 1920   # extended precision on|off (default auto)
 //! ```
 //!
 //! Each strip is the rectangle generator's press-shear case with `p + 1 × 4` nodes on
@@ -11,7 +12,9 @@
 //! at the window's start and runs to the end of the path; printed: transitions, end
 //! reason, set-up time, the start solve's time, the trace time (start included), the time
 //! per transition (start excluded), fresh factorisations of a base
-//! piece matrix, and the peak resident memory of the process so far. With
+//! piece matrix, the peak resident memory of the process so far, and whether the problem
+//! was carried in extended precision (`ext`: W refined and transition points polished in
+//! double-double; the set-up time includes the refinement). With
 //! `FRICONT_BENCH_FRESH=P`, strips with p ≤ P are traced a second time with a fresh
 //! factorisation of every piece (the reference tracer) for the ratio.
 
@@ -19,6 +22,7 @@ use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
 
+use fricont::ExtendedPrecision;
 use fricont::path::{Path, PathOptions};
 use fricont_exchange::generator::{RectSpec, generate};
 use fricont_exchange::io::CaseData;
@@ -47,9 +51,20 @@ fn strip(dir: &FsPath, p: usize) -> PathBuf {
     d
 }
 
-fn trace(case: &CaseData, fresh: bool) -> (usize, String, f64, f64, f64, usize) {
+fn trace(case: &CaseData, fresh: bool) -> (usize, String, f64, f64, f64, usize, bool) {
     let t = Instant::now();
-    let problem = Arc::new(case.problem(None).expect("problem"));
+    let mode = match std::env::var("FRICONT_BENCH_EXTENDED").as_deref() {
+        Ok("on") => ExtendedPrecision::On,
+        Ok("off") => ExtendedPrecision::Off,
+        _ => ExtendedPrecision::Auto,
+    };
+    let problem = Arc::new(
+        case.builder()
+            .extended_precision(mode)
+            .build()
+            .expect("problem"),
+    );
+    let ext = problem.extended_precision();
     let mut opts = PathOptions::window(case.alpha_start, case.alpha_end);
     opts.fresh_factorisations = fresh;
     let mut path = Path::new(problem, case.load().expect("load"), opts).expect("path");
@@ -72,6 +87,7 @@ fn trace(case: &CaseData, fresh: bool) -> (usize, String, f64, f64, f64, usize) 
         start,
         secs,
         path.refactorisations(),
+        ext,
     )
 }
 
@@ -91,7 +107,7 @@ fn main() {
         .unwrap_or(0);
     let tmp = std::env::temp_dir().join("fricont-bench-strips");
     println!(
-        "{:>6} {:>7} {:>11} {:>9} {:>9} {:>9} {:>12} {:>8} {:>9}  end",
+        "{:>6} {:>7} {:>11} {:>9} {:>9} {:>9} {:>12} {:>8} {:>9} {:>4}  end",
         "p",
         "n",
         "transitions",
@@ -100,7 +116,8 @@ fn main() {
         "trace s",
         "ms/transit.",
         "refact.",
-        "peak MiB"
+        "peak MiB",
+        "ext"
     );
     for &p in &sizes {
         let dir = strip(&tmp, p);
@@ -110,12 +127,13 @@ fn main() {
             runs.push(("fresh", true));
         }
         for (name, fresh) in runs {
-            let (tr, end, setup, start, secs, refact) = trace(&case, fresh);
+            let (tr, end, setup, start, secs, refact, ext) = trace(&case, fresh);
             println!(
-                "{p:>6} {:>7} {tr:>11} {setup:>9.2} {start:>9.2} {secs:>9.2} {:>12.2} {refact:>8} {:>9.0}  {end} ({name})",
+                "{p:>6} {:>7} {tr:>11} {setup:>9.2} {start:>9.2} {secs:>9.2} {:>12.2} {refact:>8} {:>9.0} {:>4}  {end} ({name})",
                 case.a.nrows(),
                 1e3 * (secs - start) / tr.max(1) as f64,
-                peak_mib().unwrap_or(f64::NAN)
+                peak_mib().unwrap_or(f64::NAN),
+                if ext { "yes" } else { "no" }
             );
         }
     }
