@@ -106,6 +106,9 @@ fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
     v
 }
 
+/// The piece's solve `b ↦ M_S⁻¹ b` (seed's row scaling).
+type PieceSolve<'a> = Box<dyn Fn(&[f64]) -> Vec<f64> + 'a>;
+
 /// What a refinement on one piece needs: the constants, W (both parts), the load's
 /// parts in double-double, and the piece's solves.
 struct Refiner<'a> {
@@ -113,7 +116,7 @@ struct Refiner<'a> {
     w: MatRef<'a, f64>,
     w_lo: Option<MatRef<'a, f64>>,
     classes: &'a [Class],
-    solve: Box<dyn Fn(&[f64]) -> Vec<f64> + 'a>,
+    solve: PieceSolve<'a>,
     /// q0 and q1 (high, low) of the affine load.
     q: [(Vec<f64>, Vec<f64>); 2],
     gap: &'a [f64],
@@ -224,7 +227,7 @@ impl Path {
         };
         let w = del.w();
         let row_bound = self.row_bound();
-        let solve: Box<dyn Fn(&[f64]) -> Vec<f64> + 'a> = match lu {
+        let solve: PieceSolve<'a> = match lu {
             PieceSolver::Updated(u) => {
                 Box::new(move |b: &[f64]| u.solve_checked(&c, w, b, row_bound).x)
             }
