@@ -5,10 +5,6 @@
 //! piece) is needed beyond double precision: mixed-precision refinement computes residuals
 //! in double-double and corrections with the ordinary double factorisations.
 
-// The condensation uses the error-free transformations; the rest serves the tracer's
-// double-double transition points.
-#![allow(dead_code)]
-
 use std::ops::{Add, Mul, Neg, Sub};
 
 /// `a + b = s + e` exactly (Knuth's two-sum: no assumption on the sizes).
@@ -36,12 +32,6 @@ pub(crate) struct Dd {
 
 impl Dd {
     pub const ZERO: Dd = Dd { hi: 0.0, lo: 0.0 };
-
-    /// The double `x` as a double-double.
-    #[inline]
-    pub fn from(x: f64) -> Dd {
-        Dd { hi: x, lo: 0.0 }
-    }
 
     /// `hi + lo` renormalised.
     #[inline]
@@ -87,10 +77,6 @@ impl Dd {
         let q3 = r.hi / other.hi;
         Dd::new(q1, q2).add_f64(q3)
     }
-
-    pub fn is_finite(self) -> bool {
-        self.hi.is_finite() && self.lo.is_finite()
-    }
 }
 
 impl Add for Dd {
@@ -134,8 +120,9 @@ impl Mul for Dd {
 
 /// `Σ a_k x_k` in double-double for double `a` and double-double `x = x_hi + x_lo`
 /// (the `a_k x_lo,k` terms, already tiny, summed in double): the compensated dot
-/// product of Ogita, Rump and Oishi with the low parts added.
-#[inline]
+/// product of Ogita, Rump and Oishi with the low parts added (the plain reference of
+/// [`sym_gemv_dd`] in the tests).
+#[cfg(test)]
 pub(crate) fn dot_dd(a: &[f64], x_hi: &[f64], x_lo: &[f64]) -> Dd {
     let (mut s, mut c) = (0.0f64, 0.0f64);
     for k in 0..a.len() {
@@ -223,8 +210,8 @@ mod tests {
     #[test]
     fn division_and_dot_beyond_double() {
         // 1/3 in double-double: 3 · (1/3) − 1 vanishes to ~1e-32.
-        let third = Dd::from(1.0).div(Dd::from(3.0));
-        let back = third.mul_f64(3.0) - Dd::from(1.0);
+        let third = Dd::new(1.0, 0.0).div(Dd::new(3.0, 0.0));
+        let back = third.mul_f64(3.0) - Dd::new(1.0, 0.0);
         assert!(back.to_f64().abs() < 1e-31, "{back:?}");
         // A cancelling dot product: 1e16 + 1 − 1e16 = 1 (double gives 0 or 2).
         let d = dot_dd(&[1e16, 1.0, -1e16], &[1.0, 1.0, 1.0], &[0.0; 3]);

@@ -270,8 +270,6 @@ impl BoundLoad {
     /// (2p entries each; `q0 + q0_lo` is `B A⁻¹ f0` to double-double accuracy) when the
     /// problem's W was refined ([`Delassus::w_lo`]). None for other loads or when W was not
     /// refined.
-    // Used by the tracer's double-double events (another branch) and the tests.
-    #[cfg_attr(not(test), allow(dead_code))]
     pub(crate) fn affine_lo(&self) -> Option<(&[f64], &[f64])> {
         match (&self.load, &self.q_lo) {
             (Load::Affine { .. }, Some(lo)) => Some((&lo[0], &lo[1])),
