@@ -1136,37 +1136,42 @@ pub(crate) fn condition_estimate(w: MatRef<'_, f64>, l: MatRef<'_, f64>) -> f64 
     if m == 0 {
         return 1.0;
     }
-    // A fixed start with no symmetry (a symmetric mesh's extremal eigenvectors may be
-    // orthogonal to a constant vector).
-    let start = Mat::from_fn(m, 1, |i, _| 1.0 + ((i * 7919) % 97) as f64 / 97.0);
+    // (Explicit sequential kernels: faer's operators would use its global parallelism,
+    // a thread pool in the host's process.)
+    let dot = |a: &Mat<f64>, b: &Mat<f64>| (0..m).map(|i| a[(i, 0)] * b[(i, 0)]).sum::<f64>();
     let normalise = |x: &mut Mat<f64>| {
-        let nrm = x.col(0).norm_l2();
+        let nrm = dot(x, x).sqrt();
         if nrm > 0.0 && nrm.is_finite() {
-            *x *= faer::Scale(1.0 / nrm);
+            for i in 0..m {
+                x[(i, 0)] /= nrm;
+            }
         }
     };
+    // A fixed start with no symmetry (a symmetric mesh's extremal eigenvectors may be
+    // orthogonal to a constant vector).
+    let mut start = Mat::from_fn(m, 1, |i, _| 1.0 + ((i * 7919) % 97) as f64 / 97.0);
+    normalise(&mut start);
     let mut x = start.clone();
-    normalise(&mut x);
+    let mut y = Mat::<f64>::zeros(m, 1);
     let mut lmax = 0.0;
     for _ in 0..COND_ITERS {
-        let y = w * &x;
-        lmax = (x.transpose() * &y)[(0, 0)];
-        x = y;
+        faer::linalg::matmul::matmul(y.as_mut(), Accum::Replace, w, x.as_ref(), 1.0, Par::Seq);
+        lmax = dot(&x, &y);
+        std::mem::swap(&mut x, &mut y);
         normalise(&mut x);
     }
     let mut x = start;
-    normalise(&mut x);
     let mut inv_lmin = 0.0;
     for _ in 0..COND_ITERS {
-        let mut y = x.clone();
+        y.copy_from(&x);
         faer::linalg::triangular_solve::solve_lower_triangular_in_place(l, y.as_mut(), Par::Seq);
         faer::linalg::triangular_solve::solve_upper_triangular_in_place(
             l.transpose(),
             y.as_mut(),
             Par::Seq,
         );
-        inv_lmin = (x.transpose() * &y)[(0, 0)];
-        x = y;
+        inv_lmin = dot(&x, &y);
+        std::mem::swap(&mut x, &mut y);
         normalise(&mut x);
     }
     if inv_lmin > 0.0 && lmax > 0.0 {
