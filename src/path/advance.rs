@@ -121,10 +121,6 @@ impl Path {
                 Ok(Exit::Window(Point { lam, ..pt }))
             }
             (Some((s, g)), _) => {
-                if let Some((lam, alpha, g)) = self.polish_exit(cur, &decreasing) {
-                    let pt = self.point_at(lam, alpha)?;
-                    return Ok(Exit::Guards(pt, vec![g]));
-                }
                 let (lam, alpha) = if self.load.is_affine() {
                     // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
                     // piece's factorisation) and τ from the guard's equation; no drift
@@ -176,6 +172,13 @@ impl Path {
                 } else {
                     let lam = cur.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
                     (lam, cur.alpha)
+                };
+                // In extended precision, the same exit in double-double where it lies
+                // near this one (a piece too ill-conditioned for the refinement keeps
+                // the double-precision point).
+                let (lam, alpha, g) = match self.polish_exit(cur, &decreasing) {
+                    Some((l2, a2, g2)) if super::polish::near(&l2, &lam) => (l2, a2, g2),
+                    _ => (lam, alpha, g),
                 };
                 let pt = self.point_at(lam, alpha)?;
                 Ok(Exit::Guards(pt, vec![g]))

@@ -23,6 +23,10 @@ const MAX_ROUNDS: usize = 8;
 const CONVERGED: f64 = 1e-24;
 /// A refinement that stops contracting is kept when its last correction is this small.
 const STALLED: f64 = 1e-20;
+/// A correction larger than this (relative to the solution) ends the refinement as failed.
+const ROUGH: f64 = 1e-4;
+/// See [`near`].
+const NEAR: f64 = 1e-5;
 
 /// A vector in double-double, as its high and low parts.
 #[derive(Clone)]
@@ -165,7 +169,10 @@ impl Refiner<'_> {
             let dx = (self.solve)(&r);
             let size = x.hi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
             let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            if !step.is_finite() {
+            // The guess is a double-precision solution: a correction beyond ROUGH of it
+            // means a piece matrix too ill-conditioned for refinement in double (its
+            // solves amplify rounding to that size), not a better point.
+            if !step.is_finite() || step > ROUGH * size {
                 return false;
             }
             for (k, v) in dx.iter().enumerate() {
@@ -202,6 +209,20 @@ impl Refiner<'_> {
             .map(|((mut x, _), mut d)| self.refine(&mut x, &mut d).then_some((x, d)))
             .collect()
     }
+}
+
+/// A double-double point `lam2` is taken for the double-precision one `lam` only where
+/// the two lie within [`NEAR`] of each other (relative to max|λ|): what double precision
+/// gets wrong on a slender body is ~1e-7 at most (in α, and so in λ along the piece); a
+/// larger move means a piece whose point is ill-determined, and the double point, found
+/// with the tracer's own checks, is kept.
+pub(super) fn near(lam2: &[f64], lam: &[f64]) -> bool {
+    let big = lam.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let dl = lam2
+        .iter()
+        .zip(lam)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    dl <= NEAR * big
 }
 
 impl Path {
@@ -249,7 +270,8 @@ impl Path {
 
     /// λ on the graph piece `classes` (solved by `lu`) at α, refined in double-double
     /// from the guess `lam` and rounded: the start point. None as for [`Self::refiner`],
-    /// or when the refinement does not converge.
+    /// when the refinement does not converge, or when it lands farther from `lam` than
+    /// [`near`] allows.
     pub(super) fn polish_point(
         &mut self,
         classes: &[Class],
@@ -262,7 +284,7 @@ impl Path {
         let c = r.point_constant(alpha);
         let (x, _) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
         let out: Vec<f64> = (0..x.hi.len()).map(|k| x.get(k).to_f64()).collect();
-        out.iter().all(|v| v.is_finite()).then_some(out)
+        (out.iter().all(|v| v.is_finite()) && near(&out, lam)).then_some(out)
     }
 
     /// The exit of the straight piece `cur` (affine load, α moving) through the first of
