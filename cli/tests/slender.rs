@@ -8,7 +8,7 @@
 //! brute-force enumeration of every piece, a dense condensation), then fricont's events
 //! on generated slender meshes must equal it: same transitions (node, from, to), α to 1e-10
 //! (relative to max(1, |α|); the acceptance is 1e-8), the same end of the window,
-//! from the same start (λ to 1e-10). Those meshes are carried in extended precision (W and
+//! from the same start (λ to 1e-10 as well). Those meshes are carried in extended precision (W and
 //! q in double-double, transition points polished in double-double; `auto` chooses it from
 //! κ(W)). The data determine these transition points far better than that: one
 //! unit in the last place of A moves them by less than 1e-13 (measured by

@@ -1312,7 +1312,7 @@ pub struct Comparison {
 
 impl Comparison {
     /// Everything agrees: the reference reached the window's end, fricont ended with
-    /// reason `window` at the same α, the start states agree to 1e-10 (relative to the
+    /// reason `window` at the same α, the start states agree to `tol` (relative to the
     /// largest force; in double alone fricont's condensation was only accurate to 1e-7 on
     /// the p = 480 strip, with extended precision its start agrees to ~1e-14), the events
     /// agree ([`compare_events`] to `tol`) and neither path folds
@@ -1326,7 +1326,7 @@ impl Comparison {
             )
         })?;
         let mut errs = Vec::new();
-        if self.start_diff > 1e-10 {
+        if self.start_diff > tol {
             errs.push(format!("start λ differ by {:e}", self.start_diff));
         }
         if let Err(e) = &self.events {
