@@ -149,6 +149,18 @@ fn perturbed_spread(
 
 /// Where do differences come from? fricont's own W and q (its condensation, in the
 /// caller's units) against the reference's, and the reference tracer run on fricont's
+/// ", the most at event K (node I, α = A): D" for the first of `d`, or nothing.
+fn most(d: &[(usize, f64, Ev)]) -> String {
+    d.first().map_or(String::new(), |(k, d, e)| {
+        format!(
+            ", the most at event {} (node {}, α = {:.14e}): {d:.1e}",
+            k + 1,
+            e.1 + 1,
+            e.0
+        )
+    })
+}
+
 /// condensation against fricont's events (the tracers alone).
 fn tracer_only(
     case: &fricont_exchange::io::CaseData,
@@ -190,43 +202,19 @@ fn tracer_only(
         "   reference on fricont's W, q: {} events, {} of them differ from fricont's by more than 1e-8{}",
         want.len(),
         d.len(),
-        d.first().map_or(String::new(), |(k, d, e)| format!(
-            ", the most at event {} (node {}, α = {:.14e}): {d:.1e}",
-            k + 1,
-            e.1 + 1,
-            e.0
-        ))
+        most(&d)
     );
 }
 
 /// The tracers alone on identical data: the reference's W, q0, q1 rounded to double,
 /// given to fricont as condensed input and to the reference as they are.
 fn tracers_on_rounded_data(case: &fricont_exchange::io::CaseData, cond: &Condensed) {
-    let m = 2 * cond.p;
-    let w = fricont::faer::Mat::<f64>::from_fn(m, m, |i, j| cond.w[(i, j)]);
-    let problem = fricont::ProblemBuilder::condensed(w)
-        .friction(cond.friction.clone())
-        .gap(cond.gap.clone())
-        .build()
-        .expect("condensed problem");
-    let fc = Condensed::from_double(
-        cond.w.clone(),
-        cond.q0.clone(),
-        cond.q1.clone(),
-        cond.gap.clone(),
-        cond.friction.clone(),
-    );
-    let q0: Vec<f64> = cond.q0.iter().copied().collect();
-    let q1: Vec<f64> = cond.q1.iter().copied().collect();
-    let c = common::reference::compare_with_fricont(
-        &fc,
-        Arc::new(problem),
-        &q0,
-        &q1,
+    let c = common::reference::compare_on_rounded(
+        cond,
+        fricont::ExtendedPrecision::Auto,
         case.alpha_start,
         case.alpha_end,
         1e-8,
-        &mut |_, _| {},
     );
     let want: Vec<Ev> = c
         .reference
@@ -241,12 +229,7 @@ fn tracers_on_rounded_data(case: &fricont_exchange::io::CaseData, cond: &Condens
         want.len(),
         c.fricont_end,
         d.len(),
-        d.first().map_or(String::new(), |(k, d, e)| format!(
-            ", the most at event {} (node {}, α = {:.14e}): {d:.1e}",
-            k + 1,
-            e.1 + 1,
-            e.0
-        ))
+        most(&d)
     );
 }
 

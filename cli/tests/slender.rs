@@ -19,7 +19,9 @@ mod common;
 
 use std::sync::Arc;
 
-use common::reference::{Condensed, Ev, SparseRows, compare_events, compare_with_fricont};
+use common::reference::{
+    Condensed, Ev, SparseRows, compare_events, compare_on_rounded, compare_with_fricont,
+};
 use common::{Brute, fe_case, fold_problem, mirror_pair, random_case, symmetric_case};
 use fricont::Class;
 use fricont_exchange::generator::{RectSpec, generate};
@@ -379,35 +381,12 @@ fn tracer_in_double_double_on_exact_condensed_data() {
     for friction in [0.3, 1.0] {
         let case = generate(&beam(friction)).expect("generate");
         let cond = condensed(&case);
-        let exact = Condensed::from_double(
-            cond.w.clone(),
-            cond.q0.clone(),
-            cond.q1.clone(),
-            cond.gap.clone(),
-            cond.friction.clone(),
-        );
-        let m = 2 * cond.p;
-        let problem =
-            fricont::ProblemBuilder::condensed(fricont::faer::Mat::from_fn(m, m, |i, j| {
-                cond.w[(i, j)]
-            }))
-            .friction(cond.friction.clone())
-            .gap(cond.gap.clone())
-            .extended_precision(fricont::ExtendedPrecision::On)
-            .build()
-            .expect("condensed problem");
-        assert!(problem.extended_precision());
-        let q0: Vec<f64> = cond.q0.iter().copied().collect();
-        let q1: Vec<f64> = cond.q1.iter().copied().collect();
-        let c = compare_with_fricont(
-            &exact,
-            Arc::new(problem),
-            &q0,
-            &q1,
+        let c = compare_on_rounded(
+            &cond,
+            fricont::ExtendedPrecision::On,
             case.alpha_start,
             case.alpha_end,
             1e-12,
-            &mut no_progress(),
         );
         if let Err(e) = c.check(1e-12) {
             panic!(

@@ -1381,6 +1381,49 @@ impl Comparison {
     }
 }
 
+/// The tracers alone on identical data: `cond`'s W, q0, q1 rounded to double, given to
+/// fricont as condensed input (extended precision `mode`) and to the reference as they are
+/// ([`Condensed::from_double`]), compared as [`compare_with_fricont`] does.
+pub fn compare_on_rounded(
+    cond: &Condensed,
+    mode: fricont::ExtendedPrecision,
+    a0: f64,
+    a1: f64,
+    tol: f64,
+) -> Comparison {
+    let m = 2 * cond.p;
+    let problem = fricont::ProblemBuilder::condensed(fricont::faer::Mat::from_fn(m, m, |i, j| {
+        cond.w[(i, j)]
+    }))
+    .friction(cond.friction.clone())
+    .gap(cond.gap.clone())
+    .extended_precision(mode)
+    .build()
+    .expect("condensed problem");
+    if mode == fricont::ExtendedPrecision::On {
+        assert!(problem.extended_precision());
+    }
+    let rounded = Condensed::from_double(
+        cond.w.clone(),
+        cond.q0.clone(),
+        cond.q1.clone(),
+        cond.gap.clone(),
+        cond.friction.clone(),
+    );
+    let q0: Vec<f64> = cond.q0.iter().copied().collect();
+    let q1: Vec<f64> = cond.q1.iter().copied().collect();
+    compare_with_fricont(
+        &rounded,
+        std::sync::Arc::new(problem),
+        &q0,
+        &q1,
+        a0,
+        a1,
+        tol,
+        &mut |_, _| {},
+    )
+}
+
 /// Traces `problem` with the affine load `(f0, f1)` on `[a0 → a1]` with fricont (default
 /// options) and with the reference tracer on `cond` (the same data condensed
 /// independently), starting the reference from fricont's start classes after checking
