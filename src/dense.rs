@@ -142,3 +142,67 @@ pub(crate) fn llt_lower(a: MatRef<'_, f64>) -> Result<Mat<f64>, LltError> {
     }
     Ok(l)
 }
+
+/// `Σ a_i b_i` in eight independent lanes, compiled for the machine's vector instructions
+/// by faer's dispatch (a plain `.sum()` is one sequential chain of additions that the
+/// compiler may not reorder, about one addition per cycle).
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    struct Dot<'a>(&'a [f64], &'a [f64]);
+    impl faer::traits::pulp::WithSimd for Dot<'_> {
+        type Output = f64;
+        #[inline(always)]
+        fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) -> f64 {
+            let (a, b) = (self.0, self.1);
+            let n = a.len().min(b.len());
+            let (a, b) = (&a[..n], &b[..n]);
+            let mut s = [0.0f64; 8];
+            let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+            let (ra, rb) = (ca.remainder(), cb.remainder());
+            for (x, y) in ca.zip(cb) {
+                for l in 0..8 {
+                    s[l] = x[l].mul_add(y[l], s[l]);
+                }
+            }
+            let mut tail = 0.0;
+            for (x, y) in ra.iter().zip(rb) {
+                tail += x * y;
+            }
+            ((s[0] + s[4]) + (s[1] + s[5])) + ((s[2] + s[6]) + (s[3] + s[7])) + tail
+        }
+    }
+    faer::traits::pulp::Arch::new().dispatch(Dot(a, b))
+}
+
+/// `y += a x`, compiled for the machine's vector instructions by faer's dispatch.
+pub(crate) fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    struct Axpy<'a>(&'a mut [f64], f64, &'a [f64]);
+    impl faer::traits::pulp::WithSimd for Axpy<'_> {
+        type Output = ();
+        #[inline(always)]
+        fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) {
+            let a = self.1;
+            for (yi, xi) in self.0.iter_mut().zip(self.2) {
+                *yi = a.mul_add(*xi, *yi);
+            }
+        }
+    }
+    faer::traits::pulp::Arch::new().dispatch(Axpy(y, a, x))
+}
+
+/// `W x` for every x (W square): one pass over W for all of them, on the calling thread.
+pub(crate) fn mat_mul(w: MatRef<'_, f64>, xs: &[&[f64]]) -> Vec<Vec<f64>> {
+    let m = w.nrows();
+    let xm = Mat::<f64>::from_fn(m, xs.len(), |i, j| xs[j][i]);
+    let mut out = Mat::<f64>::zeros(m, xs.len());
+    faer::linalg::matmul::matmul(
+        out.as_mut(),
+        faer::Accum::Replace,
+        w,
+        xm.as_ref(),
+        1.0,
+        Par::Seq,
+    );
+    (0..xs.len())
+        .map(|j| out.col(j).iter().copied().collect())
+        .collect()
+}

@@ -184,7 +184,8 @@ impl<'a> PieceSolves<'a> {
             .lu
             .as_ref()
             .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
-            .and_then(|u| u.extend(self.c, self.w, classes));
+            .and_then(|u| u.extend(self.c, self.w, classes, None, &[]))
+            .map(|(u, _)| u);
         if let Some(u) = extended {
             let crate::path::update::Checked { x, rel, .. } =
                 u.solve_checked(self.c, self.w, &rhs, self.row_bound);

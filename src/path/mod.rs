@@ -933,10 +933,6 @@ impl Path {
             .iter()
             .map(|v| -v)
             .collect();
-        // The tangent's direction and the piece's point at this α, from the data, in one
-        // solve. The point is found as a correction of the current λ, from its residual
-        // on this piece's equations (O(m) with the point's d): on a neighbouring piece
-        // that residual is at rounding level, and so is the correction's error.
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let rhs = c.piece_rhs(classes, &qg);
         let d = self.gaps(pt);
@@ -946,7 +942,81 @@ impl Path {
             resid[i] = -nu.eval(&pt.lam, &d);
             resid[c.p + i] = -t.eval(&pt.lam, &d);
         }
-        let solve = |u: &UpdatedLu| {
+        // On an update of the current base, the point is the current λ corrected from
+        // its residual on this piece's equations (O(m) with the point's d): on a
+        // neighbouring piece that residual is at rounding level, and so is the
+        // correction's error; its solve shares the pass over the base's factor with the
+        // new nodes' columns. The tangent needs no solve when the solution carried from
+        // the previous piece by the rank-2 updates (O(km), see update::Carried) has a
+        // residual from the data at rounding level; otherwise it is solved for (from that
+        // residual, as a correction).
+        let extended = self
+            .updater
+            .borrow()
+            .as_ref()
+            .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
+            .and_then(|u| u.extend(&c, w, classes, Some(&neg), std::slice::from_ref(&resid)));
+        let on_update = |(mut u, dx): (UpdatedLu, Vec<Vec<f64>>)| {
+            // W times the point's correction and the carried tangent: one pass over W.
+            let carried = u.carried();
+            let mut cols: Vec<&[f64]> = vec![&dx[0]];
+            cols.extend(carried.as_deref());
+            let mut prods = crate::dense::mat_mul(w, &cols).into_iter();
+            // The point and its residual from the data; refined once when that is above
+            // rounding level, and then it must be small.
+            let add = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                a.iter().zip(b).map(|(x, y)| x + y).collect()
+            };
+            let zeros = vec![0.0; m];
+            let mut xp = add(&pt.lam, &dx[0]);
+            let mut dp = add(&d, &prods.next()?);
+            let mut r = update::residual_rows(&c, classes, &xp, &dp, &zeros);
+            if update::relative_residual(&c, classes, &r, &xp, &rhs, rb) > update::REFINE_ABOVE {
+                let dx2 = u.solve_many(&c, std::slice::from_ref(&r)).pop()?;
+                xp = add(&xp, &dx2);
+                dp = add(&dp, &crate::dense::mat_mul(w, &[&dx2]).pop()?);
+                r = update::residual_rows(&c, classes, &xp, &dp, &zeros);
+                if update::relative_residual(&c, classes, &r, &xp, &rhs, rb) > 1e-12 {
+                    return None;
+                }
+            }
+            if !xp.iter().all(|v| v.is_finite()) {
+                return None;
+            }
+            // The tangent: the carried solution where its residual from the data is at
+            // rounding level, else solved for (from that residual, as a correction).
+            let carried = carried.map(|y| {
+                let wy = prods.next().expect("a product per column");
+                let r = update::residual_rows(&c, classes, &y, &wy, &neg);
+                let rel = update::relative_residual(&c, classes, &r, &y, &neg, rb);
+                (y, wy, r, rel)
+            });
+            let (y, wy) = match carried.as_ref().filter(|k| k.3 <= update::REFINE_ABOVE) {
+                Some(k) => (k.0.clone(), k.1.clone()),
+                None => {
+                    let col = update::Rhs {
+                        b: &neg,
+                        guess: carried.as_ref().map(|k| (&k.0[..], &k.2[..])),
+                    };
+                    let y = u
+                        .solve_checked_many(&c, w, &[col], rb)
+                        .pop()
+                        .filter(|y| y.rel <= 1e-12)?;
+                    // For a carried guess, wx is W times the correction only.
+                    let wy = match &carried {
+                        Some(k) => add(&k.1, &y.wx),
+                        None => y.wx,
+                    };
+                    (y.x, wy)
+                }
+            };
+            if carried.is_none() {
+                u.set_carry(&c, &neg, &y);
+            }
+            Some((u, (y, wy, xp)))
+        };
+        // A fresh base: the tangent and the point in one checked solve.
+        let on_fresh = |u: &mut UpdatedLu| {
             let cols = [
                 update::Rhs {
                     b: &neg,
@@ -960,20 +1030,18 @@ impl Path {
             let mut ch = u.solve_checked_many(&c, w, &cols, rb);
             let xp = ch.pop().expect("two columns");
             let y = ch.pop().expect("two columns");
-            (y.rel <= 1e-12 && xp.rel <= 1e-12).then_some((y.x, y.wx, xp.x))
+            if y.rel > 1e-12 || xp.rel > 1e-12 {
+                return None;
+            }
+            u.set_carry(&c, &neg, &y.x);
+            Some((y.x, y.wx, xp.x))
         };
-        let extended = self
-            .updater
-            .borrow()
-            .as_ref()
-            .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
-            .and_then(|u| u.extend(&c, w, classes));
-        let (upd, (y, wy, xp), fresh) = match extended.and_then(|u| solve(&u).map(|y| (u, y))) {
+        let (upd, (y, wy, xp), fresh) = match extended.and_then(on_update) {
             Some((u, y)) => (u, y, false),
             None => {
-                let u = UpdatedLu::factor(&c, w, classes)?;
+                let mut u = UpdatedLu::factor(&c, w, classes)?;
                 self.refactorisations.set(self.refactorisations.get() + 1);
-                let y = solve(&u)?;
+                let y = on_fresh(&mut u)?;
                 (u, y, true)
             }
         };

@@ -15,6 +15,7 @@ use faer::MatRef;
 
 use super::*;
 use crate::dd::{Dd, sym_gemv_dd};
+use crate::dense::mat_mul;
 use crate::piece::LinForm;
 
 /// Most refinement rounds of one solve.
@@ -63,15 +64,17 @@ fn gaps_dd(
 ) -> Vec<DdVec> {
     let xs: Vec<(&[f64], &[f64])> = pairs.iter().map(|(x, _)| (&x.hi[..], &x.lo[..])).collect();
     let wx = sym_gemv_dd(w, &xs);
+    let his: Vec<&[f64]> = pairs.iter().map(|(x, _)| &x.hi[..]).collect();
+    let lo = w_lo.map(|wl| mat_mul(wl, &his));
     pairs
         .iter()
         .zip(wx)
-        .map(|((x, c), wx)| {
-            let lo = w_lo.map(|wl| mat_vec(wl, &x.hi));
+        .enumerate()
+        .map(|(j, ((_, c), wx))| {
             let mut d = DdVec::from(&vec![0.0; wx.len()]);
             for (k, v) in wx.into_iter().enumerate() {
                 let v = match &lo {
-                    Some(l) => v.add_f64(l[k]),
+                    Some(l) => v.add_f64(l[j][k]),
                     None => v,
                 };
                 d.set(k, v + c.get(k));
@@ -79,21 +82,6 @@ fn gaps_dd(
             d
         })
         .collect()
-}
-
-/// `W x` in double (faer).
-fn mat_vec(w: MatRef<'_, f64>, x: &[f64]) -> Vec<f64> {
-    let mut out = faer::Mat::<f64>::zeros(w.nrows(), 1);
-    let xm = faer::MatRef::from_column_major_slice(x, x.len(), 1);
-    faer::linalg::matmul::matmul(
-        out.as_mut(),
-        faer::Accum::Replace,
-        w,
-        xm,
-        1.0,
-        faer::Par::Seq,
-    );
-    out.col(0).iter().copied().collect()
 }
 
 /// `form(λ, d)` in double-double.
@@ -110,8 +98,9 @@ fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
     v
 }
 
-/// The piece's solve `b ↦ M_S⁻¹ b` (seed's row scaling).
-type PieceSolve<'a> = Box<dyn Fn(&[f64]) -> Vec<f64> + 'a>;
+/// The piece's solves `b ↦ M_S⁻¹ b` for several columns at once (seed's row scaling;
+/// no check of their own: the refinement's residuals in double-double are the check).
+type PieceSolve<'a> = Box<dyn Fn(&[Vec<f64>]) -> Vec<Vec<f64>> + 'a>;
 
 /// What a refinement on one piece needs: the constants, W (both parts), the load's
 /// parts in double-double, and the piece's solves.
@@ -152,62 +141,77 @@ impl Refiner<'_> {
         }
     }
 
-    /// Refines x (λ at an α, or dλ/dα) with `d = W x + c` from the residual `H(x, d)` of
-    /// the piece equations in double-double and corrections by the piece's solves; d is
-    /// kept up to date by `W δ` in double (δ is small: its rounding is ~ε of δ, far below
-    /// the target). False when it does not converge.
-    fn refine(&self, x: &mut DdVec, d: &mut DdVec) -> bool {
-        let (c, m) = (&self.c, self.w.nrows());
-        let mut last = f64::INFINITY;
-        for _ in 0..MAX_ROUNDS {
-            let mut r = vec![0.0; m];
-            for (i, &cls) in self.classes.iter().enumerate() {
-                let [nu, t] = c.equations(i, cls);
-                r[i] = -eval_dd(&nu, x, d).to_f64();
-                r[c.p + i] = -eval_dd(&t, x, d).to_f64();
-            }
-            let dx = (self.solve)(&r);
-            let size = x.hi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            // The guess is a double-precision solution: a correction beyond ROUGH of it
-            // means a piece matrix too ill-conditioned for refinement in double (its
-            // solves amplify rounding to that size), not a better point.
-            if !step.is_finite() || step > ROUGH * size {
-                return false;
-            }
-            for (k, v) in dx.iter().enumerate() {
-                let s = x.get(k).add_f64(*v);
-                x.set(k, s);
-            }
-            for (k, v) in mat_vec(self.w, &dx).into_iter().enumerate() {
-                let s = d.get(k).add_f64(v);
-                d.set(k, s);
-            }
-            // Converged when this correction, or the next one predicted from the
-            // contraction so far (step² / last), is below the target.
-            if step <= CONVERGED * size || step * (step / last) <= CONVERGED * size {
-                return true;
-            }
-            // Refinement that stopped contracting has reached what the residual in
-            // double-double can resolve (~cond · ε²): accepted where that is still far
-            // beyond double.
-            if step > 0.5 * last {
-                return step <= STALLED * size;
-            }
-            last = step;
-        }
-        false
-    }
-
-    /// Refines each `(x, c)` pair from its double-precision guess: `(x, W x + c)`.
+    /// Refines each `(x, c)` pair from its double-precision guess to `(x, d = W x + c)`:
+    /// residuals `H(x, d)` of the piece equations in double-double and corrections by the
+    /// piece's solves, all pairs in lockstep (one pass over the factor and one over W per
+    /// round for all of them); d is kept up to date by `W δ` in double (δ is small: its
+    /// rounding is ~ε of δ, far below the target). None when one does not converge.
     fn refine_all(&self, pairs: Vec<(DdVec, DdVec)>) -> Option<Vec<(DdVec, DdVec)>> {
         let refs: Vec<(&DdVec, &DdVec)> = pairs.iter().map(|(x, c)| (x, c)).collect();
         let ds = gaps_dd(self.w, self.w_lo, &refs);
-        pairs
+        let mut xs: Vec<(DdVec, DdVec)> = pairs
             .into_iter()
             .zip(ds)
-            .map(|((mut x, _), mut d)| self.refine(&mut x, &mut d).then_some((x, d)))
-            .collect()
+            .map(|((x, _), d)| (x, d))
+            .collect();
+        let (c, m) = (&self.c, self.w.nrows());
+        let mut last = vec![f64::INFINITY; xs.len()];
+        let mut done = vec![false; xs.len()];
+        for _ in 0..MAX_ROUNDS {
+            let active: Vec<usize> = (0..xs.len()).filter(|&j| !done[j]).collect();
+            if active.is_empty() {
+                return Some(xs);
+            }
+            let rs: Vec<Vec<f64>> = active
+                .iter()
+                .map(|&j| {
+                    let (x, d) = &xs[j];
+                    let mut r = vec![0.0; m];
+                    for (i, &cls) in self.classes.iter().enumerate() {
+                        let [nu, t] = c.equations(i, cls);
+                        r[i] = -eval_dd(&nu, x, d).to_f64();
+                        r[c.p + i] = -eval_dd(&t, x, d).to_f64();
+                    }
+                    r
+                })
+                .collect();
+            let dxs = (self.solve)(&rs);
+            let wdx = mat_mul(self.w, &dxs.iter().map(|v| &v[..]).collect::<Vec<_>>());
+            for ((&j, dx), wdx) in active.iter().zip(&dxs).zip(wdx) {
+                let (x, d) = &mut xs[j];
+                let size = x.hi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                // The guess is a double-precision solution: a correction beyond ROUGH of
+                // it means a piece matrix too ill-conditioned for refinement in double
+                // (its solves amplify rounding to that size), not a better point.
+                if !step.is_finite() || step > ROUGH * size {
+                    return None;
+                }
+                for (k, v) in dx.iter().enumerate() {
+                    let s = x.get(k).add_f64(*v);
+                    x.set(k, s);
+                }
+                for (k, v) in wdx.into_iter().enumerate() {
+                    let s = d.get(k).add_f64(v);
+                    d.set(k, s);
+                }
+                // Converged when this correction, or the next one predicted from the
+                // contraction so far (step² / last), is below the target.
+                if step <= CONVERGED * size || step * (step / last[j]) <= CONVERGED * size {
+                    done[j] = true;
+                } else if step > 0.5 * last[j] {
+                    // Refinement that stopped contracting has reached what the residual
+                    // in double-double can resolve (~cond · ε²): accepted where that is
+                    // still far beyond double.
+                    if step > STALLED * size {
+                        return None;
+                    }
+                    done[j] = true;
+                }
+                last[j] = step;
+            }
+        }
+        done.iter().all(|&d| d).then_some(xs)
     }
 }
 
@@ -247,14 +251,11 @@ impl Path {
             None => (vec![0.0; m], vec![0.0; m]),
         };
         let w = del.w();
-        let row_bound = self.row_bound();
         let solve: PieceSolve<'a> = match lu {
-            PieceSolver::Updated(u) => {
-                Box::new(move |b: &[f64]| u.solve_checked(&c, w, b, row_bound).x)
-            }
+            PieceSolver::Updated(u) => Box::new(move |bs: &[Vec<f64>]| u.solve_many(&c, bs)),
             PieceSolver::Full(_) => {
                 let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
-                Box::new(move |b: &[f64]| lu.solve(b))
+                Box::new(move |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect())
             }
         };
         Some(Refiner {

@@ -31,6 +31,7 @@ use std::sync::{Arc, Mutex};
 use faer::MatRef;
 
 use crate::class::Class;
+use crate::dense::{axpy, dot};
 use crate::piece::{DenseLu, PieceConstants};
 
 /// Most updates kept on one base before a refactorisation: m/8 (at least 8). The
@@ -43,28 +44,63 @@ pub(crate) fn max_updates(m: usize) -> usize {
 /// A factorised base piece matrix, shared by every update derived from it.
 pub(super) struct Base {
     lu: DenseLu,
-    /// `M_0⁻¹ [e_i, e_{p+i}]` for node i, computed on first use.
-    z: Mutex<HashMap<usize, Arc<[Vec<f64>; 2]>>>,
+    /// `M_0⁻¹ [e_i, e_{p+i}]` for node i and W times it, computed on first use.
+    z: Mutex<HashMap<usize, Arc<NodeCols>>>,
 }
 
+/// The base's solution columns of one node: `M_0⁻¹ [e_i, e_{p+i}]` (in `r0` units, see
+/// the module doc).
+type NodeCols = [Vec<f64>; 2];
+
 impl Base {
-    fn z_of(&self, node: usize, p: usize) -> Arc<[Vec<f64>; 2]> {
-        let mut cache = self.z.lock().unwrap_or_else(|e| e.into_inner());
-        cache
-            .entry(node)
-            .or_insert_with(|| {
-                // Both columns in one solve: the factor is read once.
-                let m = 2 * p;
-                let mut e = faer::Mat::<f64>::zeros(m, 2);
-                e[(node, 0)] = 1.0;
-                e[(p + node, 1)] = 1.0;
-                self.lu.solve_mat(e.as_mut());
-                Arc::new([
-                    e.col(0).iter().copied().collect(),
-                    e.col(1).iter().copied().collect(),
-                ])
-            })
-            .clone()
+    fn z_of(&self, node: usize, p: usize) -> Arc<NodeCols> {
+        if let Some(z) = self.cache().get(&node) {
+            return z.clone();
+        }
+        self.solve_nodes(&[node], p, &[]);
+        self.cache()[&node].clone()
+    }
+
+    fn cache(&self) -> std::sync::MutexGuard<'_, HashMap<usize, Arc<NodeCols>>> {
+        self.z.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Solves with the base for the columns of every node of `nodes` not cached yet (kept)
+    /// and for each column of `extra` (returned): one pass over the factor for all.
+    fn solve_nodes(&self, nodes: &[usize], p: usize, extra: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let todo: Vec<usize> = {
+            let cache = self.cache();
+            let mut t: Vec<usize> = nodes
+                .iter()
+                .copied()
+                .filter(|i| !cache.contains_key(i))
+                .collect();
+            t.sort_unstable();
+            t.dedup();
+            t
+        };
+        if todo.is_empty() && extra.is_empty() {
+            return Vec::new();
+        }
+        let m = 2 * p;
+        let k = 2 * todo.len();
+        let mut e = faer::Mat::<f64>::zeros(m, k + extra.len());
+        for (j, &i) in todo.iter().enumerate() {
+            e[(i, 2 * j)] = 1.0;
+            e[(p + i, 2 * j + 1)] = 1.0;
+        }
+        for (j, b) in extra.iter().enumerate() {
+            for (r, v) in b.iter().enumerate() {
+                e[(r, k + j)] = *v;
+            }
+        }
+        self.lu.solve_mat(e.as_mut());
+        let col = |j: usize| -> Vec<f64> { e.col(j).iter().copied().collect() };
+        let mut cache = self.cache();
+        for (j, &i) in todo.iter().enumerate() {
+            cache.insert(i, Arc::new([col(2 * j), col(2 * j + 1)]));
+        }
+        (0..extra.len()).map(|j| col(k + j)).collect()
     }
 }
 
@@ -72,7 +108,21 @@ impl Base {
 struct Update {
     node: usize,
     v: [Vec<f64>; 2],
-    z: Arc<[Vec<f64>; 2]>,
+    z: Arc<NodeCols>,
+}
+
+/// The base's solution `x0 = (D M_0)⁻¹ b` of a right-hand side b carried from piece to
+/// piece: when the class of node i changes, `b` changes in rows i, p+i only (the α column
+/// of an affine load, whose q' is constant), so `x0` changes by the base's columns of node
+/// i times that change (O(m), no pass over the base's factor), and the piece's solution is
+/// `x0 − Z C⁻¹ V x0` (O(km)): what a fresh solve with the updated factorisation gives, up
+/// to the rounding of those sums. The caller checks it by its residual from the data.
+#[derive(Clone)]
+pub(crate) struct Carried {
+    /// The right-hand side, in `r0` units.
+    b: Vec<f64>,
+    /// The base's solution of it (λ units).
+    x0: Vec<f64>,
 }
 
 /// `M_S` for one class vector, as a base plus updates. Cheap to clone (the big arrays are
@@ -83,8 +133,10 @@ pub(crate) struct UpdatedLu {
     classes: Vec<Class>,
     updates: Vec<Arc<Update>>,
     /// `C⁻¹`, 2k × 2k, column-major.
-    cinv: Vec<f64>,
+    cinv: Arc<Vec<f64>>,
     det_sign: i8,
+    /// A solution carried along the updates (see [`Carried`]).
+    carry: Option<Arc<Carried>>,
 }
 
 /// The constants with the displacement rows in `r0` units (see the module doc).
@@ -105,10 +157,6 @@ fn scale_rhs(c: &PieceConstants<'_>, classes: &[Class], b: &[f64]) -> Vec<f64> {
         }
     }
     out
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// The two rows (over λ, length m) of node `i` in class `c`.
@@ -141,8 +189,9 @@ impl UpdatedLu {
             }),
             classes: classes.to_vec(),
             updates: Vec::new(),
-            cinv: Vec::new(),
+            cinv: Arc::new(Vec::new()),
             det_sign,
+            carry: None,
         })
     }
 
@@ -172,20 +221,53 @@ impl UpdatedLu {
     }
 
     /// The factorisation for `classes`, by one rank-2 update per node whose class differs.
-    /// `None` when an update makes C singular (then `M_S` is singular).
+    /// `None` when an update makes C singular (then `M_S` is singular). With `carry_to`
+    /// (the right-hand side b of `M_S y = b` for `classes`, the seed's row scaling), a
+    /// solution carried by `self` is carried along (see [`Carried`]); it is dropped when
+    /// it does not end up solving for exactly that b. Each column of `extra` (the seed's
+    /// row scaling for `classes`) is solved for with the new piece matrix, without a
+    /// check, its pass over the base's factor shared with the new nodes' columns.
     pub fn extend(
         &self,
         c: &PieceConstants<'_>,
         w: MatRef<'_, f64>,
         classes: &[Class],
-    ) -> Option<Self> {
+        carry_to: Option<&[f64]>,
+        extra: &[Vec<f64>],
+    ) -> Option<(Self, Vec<Vec<f64>>)> {
         let mut out = self.clone();
-        for i in 0..classes.len() {
-            if out.classes[i] != classes[i] {
-                out.append(c, w, i, classes[i])?;
-            }
+        let target = carry_to.map(|b| scale_rhs(c, classes, b));
+        if target.is_none() {
+            out.carry = None;
         }
-        Some(out)
+        let nodes: Vec<usize> = (0..classes.len())
+            .filter(|&i| out.classes[i] != classes[i])
+            .collect();
+        let scaled: Vec<Vec<f64>> = extra.iter().map(|b| scale_rhs(c, classes, b)).collect();
+        let x0 = self.base.solve_nodes(&nodes, c.p, &scaled);
+        for &i in &nodes {
+            out.append(c, w, i, classes[i], target.as_deref())?;
+        }
+        if let (Some(cr), Some(t)) = (&out.carry, &target)
+            && cr.b != *t
+        {
+            out.carry = None;
+        }
+        let xs = x0.into_iter().map(|x| out.correct(x)).collect();
+        Some((out, xs))
+    }
+
+    /// Keeps the right-hand side b (the seed's row scaling) of `M_S y = b`, solved by
+    /// `y`, to be carried to the next pieces (see [`Carried`]).
+    pub fn set_carry(&mut self, c: &PieceConstants<'_>, b: &[f64], y: &[f64]) {
+        // On the base itself x0 is y; on an update, one solve with the base.
+        let b = scale_rhs(c, &self.classes, b);
+        let x0 = if self.updates.is_empty() {
+            y.to_vec()
+        } else {
+            self.base_solve(&b)
+        };
+        self.carry = Some(Arc::new(Carried { b, x0 }));
     }
 
     fn append(
@@ -194,6 +276,7 @@ impl UpdatedLu {
         w: MatRef<'_, f64>,
         i: usize,
         cls: Class,
+        target: Option<&[f64]>,
     ) -> Option<()> {
         let c = &equilibrated(c);
         let new = node_rows(c, w, i, cls);
@@ -207,12 +290,12 @@ impl UpdatedLu {
         let k2 = 2 * self.updates.len();
         // Border of C: b = V_old z_new (k2 × 2), cb = v_new Z_old (2 × k2), d = I + v z.
         let mut bcol = vec![0.0; k2 * 2];
-        let mut crow = vec![0.0; 2 * k2];
+        let mut crow = [vec![0.0; k2], vec![0.0; k2]];
         for (j, u) in self.updates.iter().enumerate() {
             for a in 0..2 {
                 for b in 0..2 {
                     bcol[(2 * j + a) + k2 * b] = dot(&u.v[a], &upd.z[b]);
-                    crow[a + 2 * (2 * j + b)] = dot(&upd.v[a], &u.z[b]);
+                    crow[a][2 * j + b] = dot(&upd.v[a], &u.z[b]);
                 }
             }
         }
@@ -222,26 +305,25 @@ impl UpdatedLu {
                 *x = dot(&upd.v[a], &upd.z[b]) + if a == b { 1.0 } else { 0.0 };
             }
         }
-        // Schur complement s = d − cb C⁻¹ b, with y = C⁻¹ b (k2 × 2), x = cb C⁻¹ (2 × k2).
-        let ci = |r: usize, col: usize| self.cinv[r + k2 * col];
+        // Schur complement s = d − cb C⁻¹ b, with y = C⁻¹ b (k2 × 2), x = cb C⁻¹ (2 × k2);
+        // C⁻¹ is read by columns (contiguous).
+        let col_of = |col: usize| &self.cinv[k2 * col..k2 * (col + 1)];
         let mut y = vec![0.0; k2 * 2];
-        let mut x = vec![0.0; 2 * k2];
         for b in 0..2 {
-            for r in 0..k2 {
-                y[r + k2 * b] = (0..k2).map(|s| ci(r, s) * bcol[s + k2 * b]).sum();
-            }
-        }
-        for a in 0..2 {
+            let yb = &mut y[k2 * b..k2 * (b + 1)];
             for col in 0..k2 {
-                x[a + 2 * col] = (0..k2).map(|s| crow[a + 2 * s] * ci(s, col)).sum();
+                let f = bcol[col + k2 * b];
+                if f != 0.0 {
+                    axpy(yb, f, col_of(col));
+                }
             }
         }
+        let x: [Vec<f64>; 2] =
+            [0, 1].map(|a| (0..k2).map(|col| dot(&crow[a], col_of(col))).collect());
         let mut s = d;
         for (a, row) in s.iter_mut().enumerate() {
             for (b, e) in row.iter_mut().enumerate() {
-                *e -= (0..k2)
-                    .map(|r| crow[a + 2 * r] * y[r + k2 * b])
-                    .sum::<f64>();
+                *e -= dot(&crow[a], &y[k2 * b..k2 * (b + 1)]);
             }
         }
         let det = s[0][0] * s[1][1] - s[0][1] * s[1][0];
@@ -256,32 +338,48 @@ impl UpdatedLu {
         let n2 = k2 + 2;
         let mut cinv = vec![0.0; n2 * n2];
         // y s⁻¹ (k2 × 2)
-        let mut ys = vec![0.0; k2 * 2];
-        for r in 0..k2 {
-            for b in 0..2 {
-                ys[r + k2 * b] = y[r] * si[0][b] + y[r + k2] * si[1][b];
-            }
-        }
+        let ys: [Vec<f64>; 2] = [0, 1].map(|b| {
+            (0..k2)
+                .map(|r| y[r] * si[0][b] + y[r + k2] * si[1][b])
+                .collect()
+        });
         for col in 0..k2 {
-            for r in 0..k2 {
-                cinv[r + n2 * col] = ci(r, col) + ys[r] * x[2 * col] + ys[r + k2] * x[1 + 2 * col];
-            }
+            let out = &mut cinv[n2 * col..n2 * (col + 1)];
+            out[..k2].copy_from_slice(col_of(col));
+            axpy(&mut out[..k2], x[0][col], &ys[0]);
+            axpy(&mut out[..k2], x[1][col], &ys[1]);
             for a in 0..2 {
-                cinv[k2 + a + n2 * col] = -(si[a][0] * x[2 * col] + si[a][1] * x[1 + 2 * col]);
+                out[k2 + a] = -(si[a][0] * x[0][col] + si[a][1] * x[1][col]);
             }
         }
         for b in 0..2 {
+            let out = &mut cinv[n2 * (k2 + b)..n2 * (k2 + b + 1)];
             for r in 0..k2 {
-                cinv[r + n2 * (k2 + b)] = -ys[r + k2 * b];
+                out[r] = -ys[b][r];
             }
             for a in 0..2 {
-                cinv[k2 + a + n2 * (k2 + b)] = si[a][b];
+                out[k2 + a] = si[a][b];
             }
         }
         if cinv.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        self.cinv = cinv;
+        // The carried right-hand side and its base solution: b changes in node i's rows.
+        self.carry = match (self.carry.take(), target) {
+            (Some(cr), Some(t)) => {
+                let mut cr = Arc::unwrap_or_clone(cr);
+                for (a, row) in [i, c.p + i].into_iter().enumerate() {
+                    let delta = t[row] - cr.b[row];
+                    if delta != 0.0 {
+                        axpy(&mut cr.x0, delta, &upd.z[a]);
+                    }
+                    cr.b[row] = t[row];
+                }
+                cr.x0.iter().all(|v| v.is_finite()).then(|| Arc::new(cr))
+            }
+            _ => None,
+        };
+        self.cinv = Arc::new(cinv);
         if det < 0.0 {
             self.det_sign = -self.det_sign;
         }
@@ -296,39 +394,61 @@ impl UpdatedLu {
         let m = self.base.lu.n();
         let mut xm = faer::Mat::<f64>::from_fn(m, bs.len(), |i, c| bs[c][i]);
         self.base.lu.solve_mat(xm.as_mut());
-        let k2 = 2 * self.updates.len();
         (0..bs.len())
-            .map(|c| {
-                let mut x: Vec<f64> = xm.col(c).iter().copied().collect();
-                if k2 == 0 {
-                    return x;
-                }
-                let mut vx = vec![0.0; k2];
-                for (j, u) in self.updates.iter().enumerate() {
-                    vx[2 * j] = dot(&u.v[0], &x);
-                    vx[2 * j + 1] = dot(&u.v[1], &x);
-                }
-                let mut wv = vec![0.0; k2];
-                for (col, &v) in vx.iter().enumerate() {
-                    if v != 0.0 {
-                        for (r, o) in wv.iter_mut().enumerate() {
-                            *o += self.cinv[r + k2 * col] * v;
-                        }
-                    }
-                }
-                for (j, u) in self.updates.iter().enumerate() {
-                    for a in 0..2 {
-                        let c = wv[2 * j + a];
-                        if c != 0.0 {
-                            for (xi, zi) in x.iter_mut().zip(&u.z[a]) {
-                                *xi -= c * zi;
-                            }
-                        }
-                    }
-                }
-                x
-            })
+            .map(|c| self.correct(xm.col(c).iter().copied().collect()))
             .collect()
+    }
+
+    /// `x0 − Z C⁻¹ V x0`: the base's solution `x0` of a column made the piece's (O(km)).
+    fn correct(&self, mut x: Vec<f64>) -> Vec<f64> {
+        let k2 = 2 * self.updates.len();
+        if k2 == 0 {
+            return x;
+        }
+        let mut vx = vec![0.0; k2];
+        for (j, u) in self.updates.iter().enumerate() {
+            vx[2 * j] = dot(&u.v[0], &x);
+            vx[2 * j + 1] = dot(&u.v[1], &x);
+        }
+        let mut wv = vec![0.0; k2];
+        for (col, &v) in vx.iter().enumerate() {
+            if v != 0.0 {
+                axpy(&mut wv, v, &self.cinv[k2 * col..k2 * (col + 1)]);
+            }
+        }
+        for (j, u) in self.updates.iter().enumerate() {
+            for a in 0..2 {
+                let c = wv[2 * j + a];
+                if c != 0.0 {
+                    axpy(&mut x, -c, &u.z[a]);
+                }
+            }
+        }
+        x
+    }
+
+    /// `M_S⁻¹ b` for every column `b` (the seed's row scaling), without a check: one
+    /// pass over the base's factor for all of them. For callers that check by themselves
+    /// (the refinement in double-double).
+    pub fn solve_many(&self, c: &PieceConstants<'_>, bs: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let scaled: Vec<Vec<f64>> = bs.iter().map(|b| scale_rhs(c, &self.classes, b)).collect();
+        self.solve(&scaled)
+    }
+
+    /// The solution `y` of the carried right-hand side (see [`Carried`]), if any (O(km)):
+    /// unchecked (the caller checks it by its residual from the data, [`residual_rows`]).
+    pub fn carried(&self) -> Option<Vec<f64>> {
+        self.carry.as_deref().map(|c| self.correct(c.x0.clone()))
+    }
+
+    /// `(D M_0)⁻¹ b` (b in `r0` units): one pass over the base's factor.
+    fn base_solve(&self, b: &[f64]) -> Vec<f64> {
+        let mut x = b.to_vec();
+        let m = x.len();
+        self.base
+            .lu
+            .solve_mat(faer::MatMut::from_column_major_slice_mut(&mut x, m, 1));
+        x
     }
 
     /// `M_S⁻¹ b` with its check (see [`Self::solve_checked_many`]).
@@ -442,6 +562,43 @@ pub(crate) struct Checked {
     solved: Vec<f64>,
     /// The residual `D (b − M_S x)`.
     r: Vec<f64>,
+}
+
+/// `b − M_S x` (the seed's row scaling) for the piece `classes` from x and `d = W x + k`:
+/// with k = 0 the residual of `M_S x = b`; with k = q − (g, 0) and b = 0 that of the piece
+/// equations at a point.
+pub(crate) fn residual_rows(
+    c: &PieceConstants<'_>,
+    classes: &[Class],
+    x: &[f64],
+    d: &[f64],
+    b: &[f64],
+) -> Vec<f64> {
+    let mut r = b.to_vec();
+    for (i, &cls) in classes.iter().enumerate() {
+        let [nu, t] = c.equations(i, cls);
+        r[i] -= nu.eval(x, d);
+        r[c.p + i] -= t.eval(x, d);
+    }
+    r
+}
+
+/// The relative residual of `x` on the equations of `classes` whose residual is `r`
+/// (`b − M_S x`, the seed's row scaling), as [`UpdatedLu::solve_checked_many`] measures
+/// it: `‖D r‖∞ / (row_bound ‖x‖∞ + ‖D b‖∞)`, D the row scaling to `r0` units.
+pub(crate) fn relative_residual(
+    c: &PieceConstants<'_>,
+    classes: &[Class],
+    r: &[f64],
+    x: &[f64],
+    b: &[f64],
+    row_bound: f64,
+) -> f64 {
+    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let denom = row_bound * inf(x) + inf(&scale_rhs(c, classes, b));
+    let num = inf(&scale_rhs(c, classes, r));
+    let rel = if denom > 0.0 { num / denom } else { num };
+    if rel.is_finite() { rel } else { f64::INFINITY }
 }
 
 /// Relative residual above which a solve is refined once (a few units of rounding: a
