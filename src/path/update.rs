@@ -123,6 +123,8 @@ pub(crate) struct Carried {
     b: Vec<f64>,
     /// The base's solution of it (λ units).
     x0: Vec<f64>,
+    /// The piece's solution of it, where it was computed ([`UpdatedLu::extend`]).
+    y: Option<Vec<f64>>,
 }
 
 /// `M_S` for one class vector, as a base plus updates. Cheap to clone (the big arrays are
@@ -253,7 +255,22 @@ impl UpdatedLu {
         {
             out.carry = None;
         }
-        let xs = x0.into_iter().map(|x| out.correct(x)).collect();
+        // The extras and the carried solution, corrected together.
+        let mut cols = x0;
+        let n_extra = cols.len();
+        if let Some(cr) = &out.carry {
+            cols.push(cr.x0.clone());
+        }
+        let mut xs = out.correct_many(cols);
+        if xs.len() > n_extra
+            && let Some(cr) = out.carry.take()
+        {
+            let y = xs.pop();
+            out.carry = Some(Arc::new(Carried {
+                y,
+                ..Arc::unwrap_or_clone(cr)
+            }));
+        }
         Some((out, xs))
     }
 
@@ -267,7 +284,7 @@ impl UpdatedLu {
         } else {
             self.base_solve(&b)
         };
-        self.carry = Some(Arc::new(Carried { b, x0 }));
+        self.carry = Some(Arc::new(Carried { b, x0, y: None }));
     }
 
     fn append(
@@ -375,6 +392,7 @@ impl UpdatedLu {
                     }
                     cr.b[row] = t[row];
                 }
+                cr.y = None;
                 cr.x0.iter().all(|v| v.is_finite()).then(|| Arc::new(cr))
             }
             _ => None,
@@ -394,37 +412,51 @@ impl UpdatedLu {
         let m = self.base.lu.n();
         let mut xm = faer::Mat::<f64>::from_fn(m, bs.len(), |i, c| bs[c][i]);
         self.base.lu.solve_mat(xm.as_mut());
-        (0..bs.len())
-            .map(|c| self.correct(xm.col(c).iter().copied().collect()))
-            .collect()
+        self.correct_many(
+            (0..bs.len())
+                .map(|c| xm.col(c).iter().copied().collect())
+                .collect(),
+        )
     }
 
-    /// `x0 − Z C⁻¹ V x0`: the base's solution `x0` of a column made the piece's (O(km)).
-    fn correct(&self, mut x: Vec<f64>) -> Vec<f64> {
+    /// `x0 − Z C⁻¹ V x0` for every x0 of `xs`: base solutions made the piece's (O(km)),
+    /// all in one pass over the updates' rows and columns.
+    fn correct_many(&self, mut xs: Vec<Vec<f64>>) -> Vec<Vec<f64>> {
         let k2 = 2 * self.updates.len();
         if k2 == 0 {
-            return x;
+            return xs;
         }
-        let mut vx = vec![0.0; k2];
-        for (j, u) in self.updates.iter().enumerate() {
-            vx[2 * j] = dot(&u.v[0], &x);
-            vx[2 * j + 1] = dot(&u.v[1], &x);
-        }
-        let mut wv = vec![0.0; k2];
-        for (col, &v) in vx.iter().enumerate() {
-            if v != 0.0 {
-                axpy(&mut wv, v, &self.cinv[k2 * col..k2 * (col + 1)]);
-            }
-        }
+        let mut vx = vec![vec![0.0; k2]; xs.len()];
         for (j, u) in self.updates.iter().enumerate() {
             for a in 0..2 {
-                let c = wv[2 * j + a];
-                if c != 0.0 {
-                    axpy(&mut x, -c, &u.z[a]);
+                for (t, x) in xs.iter().enumerate() {
+                    vx[t][2 * j + a] = dot(&u.v[a], x);
                 }
             }
         }
-        x
+        let wv: Vec<Vec<f64>> = vx
+            .iter()
+            .map(|vx| {
+                let mut wv = vec![0.0; k2];
+                for (col, &v) in vx.iter().enumerate() {
+                    if v != 0.0 {
+                        axpy(&mut wv, v, &self.cinv[k2 * col..k2 * (col + 1)]);
+                    }
+                }
+                wv
+            })
+            .collect();
+        for (j, u) in self.updates.iter().enumerate() {
+            for a in 0..2 {
+                for (x, wv) in xs.iter_mut().zip(&wv) {
+                    let c = wv[2 * j + a];
+                    if c != 0.0 {
+                        axpy(x, -c, &u.z[a]);
+                    }
+                }
+            }
+        }
+        xs
     }
 
     /// `M_S⁻¹ b` for every column `b` (the seed's row scaling), without a check: one
@@ -438,7 +470,11 @@ impl UpdatedLu {
     /// The solution `y` of the carried right-hand side (see [`Carried`]), if any (O(km)):
     /// unchecked (the caller checks it by its residual from the data, [`residual_rows`]).
     pub fn carried(&self) -> Option<Vec<f64>> {
-        self.carry.as_deref().map(|c| self.correct(c.x0.clone()))
+        let cr = self.carry.as_deref()?;
+        Some(match &cr.y {
+            Some(y) => y.clone(),
+            None => self.correct_many(vec![cr.x0.clone()]).pop()?,
+        })
     }
 
     /// `(D M_0)⁻¹ b` (b in `r0` units): one pass over the base's factor.
