@@ -167,11 +167,13 @@ struct PieceSolves<'a> {
 }
 
 impl<'a> PieceSolves<'a> {
-    fn new(c: &'a PieceConstants<'a>, w: MatRef<'a, f64>) -> Self {
+    /// Starting from `seed` (a factorisation to update, e.g. the path's current one) when
+    /// given.
+    fn new(c: &'a PieceConstants<'a>, w: MatRef<'a, f64>, seed: Option<UpdatedLu>) -> Self {
         Self {
             c,
             w,
-            lu: None,
+            lu: seed,
             row_bound: update::row_bound(c, w),
         }
     }
@@ -208,19 +210,18 @@ impl<'a> PieceSolves<'a> {
 /// Semi-smooth Newton with Armijo backtracking. Returns the last iterate and whether it
 /// converged, plus a short description.
 fn newton(
-    c: &PieceConstants,
-    w: MatRef<'_, f64>,
+    pieces: &mut PieceSolves<'_>,
     qg: &[f64],
     lam0: Vec<f64>,
     max_iter: usize,
     fr: Frozen<'_>,
 ) -> (Vec<f64>, bool, String) {
+    let (c, w) = (pieces.c, pieces.w);
     let mut lam = lam0;
     let mut phi = merit(c, w, qg, &lam, fr);
     // Consecutive Newton steps usually change the classes of a few nodes: their piece
     // matrices are solved by rank-2 updates of one factorisation (O(m²) each), with a
     // fresh factorisation when many nodes changed or an update loses accuracy.
-    let mut pieces = PieceSolves::new(c, w);
     for it in 0..max_iter {
         if rel_residual(c, w, qg, &lam, fr) <= TOL {
             return (lam, true, format!("Newton converged in {it} iterations"));
@@ -279,17 +280,16 @@ fn newton(
 /// piece is singular, or after `max_iter` steps, and returns the iterate with the least
 /// residual for [`newton`] to go on from.
 fn active_set(
-    c: &PieceConstants,
-    w: MatRef<'_, f64>,
+    pieces: &mut PieceSolves<'_>,
     qg: &[f64],
     lam0: Vec<f64>,
     max_iter: usize,
     fr: Frozen<'_>,
 ) -> (Vec<f64>, bool, String) {
+    let (c, w) = (pieces.c, pieces.w);
     let mut res = rel_residual(c, w, qg, &lam0, fr);
     let mut best = (res, lam0.clone());
     let mut lam = lam0;
-    let mut pieces = PieceSolves::new(c, w);
     let mut seen = std::collections::HashSet::new();
     for it in 0..max_iter {
         if res <= TOL {
@@ -450,36 +450,40 @@ pub(crate) fn solve_fixed_alpha(
     guess: Option<&[f64]>,
     alpha: f64,
 ) -> Result<Vec<f64>> {
-    solve_with_frozen(problem, qg, guess, alpha, None)
+    solve_with_frozen(problem, qg, guess, alpha, None, None)
 }
 
-/// As [`solve_fixed_alpha`], with the classes of some nodes imposed.
+/// As [`solve_fixed_alpha`], with the classes of some nodes imposed, and the piece solves
+/// by updates of `seed` where given (a factorisation of a nearby piece: the path's, for
+/// the directional problem at a vertex, so that it costs O(m²) per piece, not O(m³)).
 pub(crate) fn solve_with_frozen(
     problem: &crate::problem::Problem,
     qg: &[f64],
     guess: Option<&[f64]>,
     alpha: f64,
     fr: Frozen<'_>,
+    seed: Option<UpdatedLu>,
 ) -> Result<Vec<f64>> {
     let c = PieceConstants::of(problem);
     let w = problem.delassus().w();
     let m = 2 * c.p;
+    let mut pieces = PieceSolves::new(&c, w, seed);
     let lam0 = guess.map(|g| g.to_vec()).unwrap_or_else(|| vec![0.0; m]);
     let mut notes = Vec::new();
     // Damped Newton first (its line search keeps it near its start, so on a problem with
     // several solutions at α it finds the same one whatever the rounding), then, where it
     // creeps, the active-set iteration from its iterate, then Newton again.
-    let (lam, ok, msg) = newton(&c, w, qg, lam0, 20, fr);
+    let (lam, ok, msg) = newton(&mut pieces, qg, lam0, 20, fr);
     if ok {
         return Ok(lam);
     }
     notes.push(msg);
-    let (lam, ok, msg) = active_set(&c, w, qg, lam, 100, fr);
+    let (lam, ok, msg) = active_set(&mut pieces, qg, lam, 100, fr);
     if ok {
         return Ok(lam);
     }
     notes.push(msg);
-    let (lam, ok, msg) = newton(&c, w, qg, lam, 200, fr);
+    let (lam, ok, msg) = newton(&mut pieces, qg, lam, 200, fr);
     if ok {
         return Ok(lam);
     }
@@ -490,7 +494,7 @@ pub(crate) fn solve_with_frozen(
     let mut lam = lam;
     for round in 0..20 {
         let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20, fr);
-        let (l, ok, msg) = newton(&c, w, qg, lam_gs, 50, fr);
+        let (l, ok, msg) = newton(&mut pieces, qg, lam_gs, 50, fr);
         if ok {
             return Ok(l);
         }
@@ -500,14 +504,14 @@ pub(crate) fn solve_with_frozen(
         }
     }
     let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20_000, fr);
-    let (lam, ok, msg) = newton(&c, w, qg, lam_gs, 200, fr);
+    let (lam, ok, msg) = newton(&mut pieces, qg, lam_gs, 200, fr);
     if ok {
         return Ok(lam);
     }
     notes.push(format!("after block Gauss-Seidel: {msg}"));
     // Last resort: the same from zero forces and from a uniform-stick start.
     for start in [vec![0.0; m], stick_start(&c, w, qg)] {
-        let (lam, ok, msg) = newton(&c, w, qg, start, 200, fr);
+        let (lam, ok, msg) = newton(&mut pieces, qg, start, 200, fr);
         if ok {
             return Ok(lam);
         }

@@ -244,7 +244,9 @@ impl Path {
         s: f64,
     ) -> Option<Vec<Class>> {
         let qdir: Vec<f64> = pt.dq.iter().map(|v| s * v).collect();
-        let lam = solve_with_frozen(&self.problem, &qdir, None, pt.alpha, Some(frozen)).ok()?;
+        let seed = self.updater.borrow().clone();
+        let lam =
+            solve_with_frozen(&self.problem, &qdir, None, pt.alpha, Some(frozen), seed).ok()?;
         let w = self.problem.delassus().w();
         let d = displacement_gaps(w, &qdir, &lam);
         let r0 = self.problem.default_r();
@@ -292,7 +294,8 @@ impl Path {
         }
         nodes.sort_unstable();
         nodes.dedup();
-        let pt = self.snap_to_vertex(pt, &tol)?;
+        let entry = self.point_at(cur.lam.clone(), cur.alpha)?;
+        let pt = self.snap_to_vertex(pt, &tol, &entry)?;
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
         let mut cands = self.continuations(&pt, &cur.classes, &nodes, back, false)?;
         if cands.is_empty() {
@@ -360,35 +363,34 @@ impl Path {
     /// passes through the state of zero contact forces), the exit point found from one
     /// guard carries that guard's rounding; the exact point is `λ = 0` at the α that
     /// minimises `‖q(α) − (g, 0)‖` (closed form for an affine load). Other points are
-    /// returned unchanged.
-    pub(super) fn snap_to_vertex(&mut self, pt: Point, tol: &Tol) -> Result<Point> {
+    /// returned unchanged. "At the vertex" is judged against the forces along the piece
+    /// the path came by (`entry`: the point where it entered it), not against the point's
+    /// own: there the forces are rounding noise of the piece's solves, as large as
+    /// themselves, and no class would fit them.
+    pub(super) fn snap_to_vertex(&mut self, pt: Point, tol: &Tol, entry: &Point) -> Result<Point> {
         let p = self.problem.p();
-        if inf_norm(&pt.lam) > tol.disp
-            || self
-                .compatible(&(0..p).collect::<Vec<_>>(), &pt, tol)
-                .iter()
-                .any(|c| c.len() < 4)
-        {
+        let z = self.opts.zero_tol;
+        let reference = self.force_scale(&pt).max(self.force_scale(entry));
+        if inf_norm(&pt.lam) > tol.disp.max(z * reference) {
             return Ok(pt);
         }
         let m = 2 * p;
         let alpha = if self.load.is_affine() {
-            let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+            // From the load's parts, α* = −(q0 − g)·q1 / |q1|²: exactly 0 for a homogeneous
+            // load (q0 = g = 0), where every tolerance at the vertex is relative to zero.
+            let (q0, q1) = self.load.q(0.0, self.problem.delassus())?;
+            let qg = shift_gap(&q0, self.problem.gap_equilibrated());
             let (num, den) = qg
                 .iter()
-                .zip(&pt.dq)
+                .zip(&q1)
                 .fold((0.0, 0.0), |(a, b), (x, y)| (a + x * y, b + y * y));
-            if den > 0.0 {
-                pt.alpha - num / den
-            } else {
-                pt.alpha
-            }
+            if den > 0.0 { -num / den } else { pt.alpha }
         } else {
             pt.alpha
         };
         let snapped = self.point_at(vec![0.0; m], alpha)?;
         let qg = shift_gap(&snapped.q, self.problem.gap_equilibrated());
-        if self.problem.default_r() * inf_norm(&qg) <= tol.disp {
+        if self.problem.default_r() * inf_norm(&qg) <= tol.disp.max(z * reference) {
             Ok(snapped)
         } else {
             Ok(pt)

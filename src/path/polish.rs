@@ -98,8 +98,7 @@ fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
     v
 }
 
-/// The piece's solves `b ↦ M_S⁻¹ b` for several columns at once (seed's row scaling;
-/// no check of their own: the refinement's residuals in double-double are the check).
+/// The piece's solves `b ↦ M_S⁻¹ b` for several columns at once (seed's row scaling).
 type PieceSolve<'a> = Box<dyn Fn(&[Vec<f64>]) -> Vec<Vec<f64>> + 'a>;
 
 /// What a refinement on one piece needs: the constants, W (both parts), the load's
@@ -251,8 +250,21 @@ impl Path {
             None => (vec![0.0; m], vec![0.0; m]),
         };
         let w = del.w();
+        let row_bound = self.row_bound();
         let solve: PieceSolve<'a> = match lu {
-            PieceSolver::Updated(u) => Box::new(move |bs: &[Vec<f64>]| u.solve_many(&c, bs)),
+            // Checked solves (each refined once in double where its residual is above
+            // rounding level): on the slenderest strips (p = 1920) the outer refinement
+            // with plain solves contracted too slowly and gave up.
+            PieceSolver::Updated(u) => Box::new(move |bs: &[Vec<f64>]| {
+                let cols: Vec<update::Rhs<'_>> = bs
+                    .iter()
+                    .map(|b| update::Rhs { b, guess: None })
+                    .collect();
+                u.solve_checked_many(&c, w, &cols, row_bound)
+                    .into_iter()
+                    .map(|k| k.x)
+                    .collect()
+            }),
             PieceSolver::Full(_) => {
                 let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
                 Box::new(move |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect())
