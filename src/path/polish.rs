@@ -253,13 +253,11 @@ impl Path {
         let row_bound = self.row_bound();
         let solve: PieceSolve<'a> = match lu {
             // Checked solves (each refined once in double where its residual is above
-            // rounding level): on the slenderest strips (p = 1920) the outer refinement
-            // with plain solves contracted too slowly and gave up.
+            // rounding level): each outer round then contracts by about (κ ε)², not κ ε,
+            // on pieces near the limit of double precision.
             PieceSolver::Updated(u) => Box::new(move |bs: &[Vec<f64>]| {
-                let cols: Vec<update::Rhs<'_>> = bs
-                    .iter()
-                    .map(|b| update::Rhs { b, guess: None })
-                    .collect();
+                let cols: Vec<update::Rhs<'_>> =
+                    bs.iter().map(|b| update::Rhs { b, guess: None }).collect();
                 u.solve_checked_many(&c, w, &cols, row_bound)
                     .into_iter()
                     .map(|k| k.x)
