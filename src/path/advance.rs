@@ -58,7 +58,15 @@ impl Path {
     /// guards and the window, then the exact point by one bordered solve.
     pub(super) fn exit_linear(&mut self, cur: &CurrentPiece) -> Result<Exit> {
         let m = 2 * self.problem.p();
-        let pt = self.point_at(cur.lam.clone(), cur.alpha)?;
+        // The piece's own point at the entry α where it was solved for (it may differ from
+        // the transition point by cond · ε on an ill-conditioned piece): the guards are
+        // measured there, on the line the exit point is then taken from.
+        let lam0 = cur
+            .xp
+            .as_deref()
+            .cloned()
+            .unwrap_or_else(|| cur.lam.clone());
+        let pt = self.point_at(lam0, cur.alpha)?;
         let tol = self.tol_at(&pt);
         let table = self.guard_table(&cur.classes, &pt, Some((&cur.t, &cur.rate)));
         let mut best: Option<(f64, Guard)> = None;
@@ -138,7 +146,7 @@ impl Path {
                     let c0 = v0
                         - row[..m]
                             .iter()
-                            .zip(&cur.lam)
+                            .zip(&pt.lam)
                             .map(|(a, b)| a * b)
                             .sum::<f64>()
                         - row[m] * cur.alpha;
@@ -166,11 +174,11 @@ impl Path {
                     if x.iter().all(|v| v.is_finite()) {
                         (x[..m].to_vec(), x[m])
                     } else {
-                        let lam = cur.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
+                        let lam = pt.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
                         (lam, cur.alpha + s * cur.t[m])
                     }
                 } else {
-                    let lam = cur.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
+                    let lam = pt.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
                     (lam, cur.alpha)
                 };
                 // In extended precision, the same exit in double-double where it lies

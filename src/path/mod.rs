@@ -248,9 +248,10 @@ pub struct Path {
     refactorisations: Cell<usize>,
     /// Bound on the row sums of any piece matrix, computed on first use.
     row_bound: Cell<Option<f64>>,
-    /// The last `d = q − (g, 0) + W λ` with its (α, λ): every candidate piece at a
-    /// transition point needs it.
-    gaps_cache: RefCell<Option<GapsAt>>,
+    /// The last few `d = q − (g, 0) + W λ` with their (α, λ): every candidate piece at a
+    /// transition point needs the point's, and the ratio test on the piece taken needs
+    /// that of the piece's own point (primed when it was solved for).
+    gaps_cache: RefCell<Vec<GapsAt>>,
     /// The last point's "at zero" thresholds with its (α, λ).
     tol_cache: RefCell<Option<(f64, Vec<f64>, Tol)>>,
 }
@@ -637,7 +638,7 @@ impl Path {
             updater: RefCell::new(None),
             refactorisations: Cell::new(0),
             row_bound: Cell::new(None),
-            gaps_cache: RefCell::new(None),
+            gaps_cache: RefCell::new(Vec::new()),
             tol_cache: RefCell::new(None),
         })
     }
@@ -850,17 +851,31 @@ impl Path {
         lam.iter().enumerate().map(|(k, v)| v * s[k % p]).collect()
     }
 
-    /// `d = q − (g, 0) + W λ` at a point (one product with W, cached for the last point).
+    /// `d = q − (g, 0) + W λ` at a point (one product with W, cached for the last few
+    /// points).
     fn gaps(&self, pt: &Point) -> Arc<Vec<f64>> {
-        if let Some((a, lam, d)) = &*self.gaps_cache.borrow()
-            && *a == pt.alpha
-            && *lam == pt.lam
+        if let Some((_, _, d)) = self
+            .gaps_cache
+            .borrow()
+            .iter()
+            .find(|(a, lam, _)| *a == pt.alpha && *lam == pt.lam)
         {
             return d.clone();
         }
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
-        let d = Arc::new(displacement_gaps(self.problem.delassus().w(), &qg, &pt.lam));
-        *self.gaps_cache.borrow_mut() = Some((pt.alpha, pt.lam.clone(), d.clone()));
+        let d = displacement_gaps(self.problem.delassus().w(), &qg, &pt.lam);
+        self.prime_gaps(pt.alpha, &pt.lam, d)
+    }
+
+    /// Keeps `d` of the point `(α, λ)`, computed by the caller, for [`Self::gaps`].
+    fn prime_gaps(&self, alpha: f64, lam: &[f64], d: Vec<f64>) -> Arc<Vec<f64>> {
+        const KEEP: usize = 4;
+        let d = Arc::new(d);
+        let mut cache = self.gaps_cache.borrow_mut();
+        if cache.len() == KEEP {
+            cache.remove(0);
+        }
+        cache.push((alpha, lam.to_vec(), d.clone()));
         d
     }
 
@@ -983,6 +998,8 @@ impl Path {
             if !xp.iter().all(|v| v.is_finite()) {
                 return None;
             }
+            // d at the piece's point, for the ratio test that starts there.
+            self.prime_gaps(pt.alpha, &xp, dp);
             // The tangent: the carried solution where its residual from the data is at
             // rounding level, else solved for (from that residual, as a correction).
             let carried = carried.map(|y| {
@@ -1033,6 +1050,11 @@ impl Path {
             if y.rel > 1e-12 || xp.rel > 1e-12 {
                 return None;
             }
+            self.prime_gaps(
+                pt.alpha,
+                &xp.x,
+                d.iter().zip(&xp.wx).map(|(a, b)| a + b).collect(),
+            );
             u.set_carry(&c, &neg, &y.x);
             Some((y.x, y.wx, xp.x))
         };
