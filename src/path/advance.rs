@@ -67,7 +67,12 @@ impl Path {
             .cloned()
             .unwrap_or_else(|| cur.lam.clone());
         let pt = self.point_at(lam0, cur.alpha)?;
-        let tol = self.tol_at(&pt);
+        // The thresholds are those of the transition point (computed, row by row, when
+        // the path joined the piece there; the two points differ by rounding only).
+        let tol = self.tol_at(&Point {
+            lam: cur.lam.clone(),
+            ..pt.clone()
+        });
         let table = self.guard_table(&cur.classes, &pt, Some((&cur.t, &cur.rate)));
         let mut best: Option<(f64, Guard)> = None;
         let mut decreasing = Vec::new();
