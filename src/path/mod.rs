@@ -951,12 +951,8 @@ impl Path {
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let rhs = c.piece_rhs(classes, &qg);
         let d = self.gaps(pt);
-        let mut resid = vec![0.0; m];
-        for (i, &cl) in classes.iter().enumerate() {
-            let [nu, t] = c.equations(i, cl);
-            resid[i] = -nu.eval(&pt.lam, &d);
-            resid[c.p + i] = -t.eval(&pt.lam, &d);
-        }
+        let zeros = vec![0.0; m];
+        let resid = update::residual_rows(&c, classes, &pt.lam, &d, &zeros);
         // On an update of the current base, the point is the current λ corrected from
         // its residual on this piece's equations (O(m) with the point's d): on a
         // neighbouring piece that residual is at rounding level, and so is the
@@ -982,7 +978,6 @@ impl Path {
             let add = |a: &[f64], b: &[f64]| -> Vec<f64> {
                 a.iter().zip(b).map(|(x, y)| x + y).collect()
             };
-            let zeros = vec![0.0; m];
             let mut xp = add(&pt.lam, &dx[0]);
             let mut dp = add(&d, &prods.next()?);
             let mut r = update::residual_rows(&c, classes, &xp, &dp, &zeros);
@@ -1027,7 +1022,9 @@ impl Path {
                     (y.x, wy)
                 }
             };
-            if carried.is_none() {
+            // Only an affine load's α column stays put from piece to piece: elsewhere a
+            // carry would cost a base solve here and be dropped at the next update.
+            if carried.is_none() && self.load.is_affine() {
                 u.set_carry(&c, &neg, &y);
             }
             Some((u, (y, wy, xp)))

@@ -649,30 +649,11 @@ fn residuals(
     xs: &[Vec<f64>],
     bs: &[Vec<f64>],
 ) -> Vec<(Vec<f64>, Vec<f64>)> {
-    let m = w.nrows();
-    let xm = faer::Mat::<f64>::from_fn(m, xs.len(), |i, k| xs[k][i]);
-    let mut dm = faer::Mat::<f64>::zeros(m, xs.len());
-    faer::linalg::matmul::matmul(
-        dm.as_mut(),
-        faer::Accum::Replace,
-        w,
-        xm.as_ref(),
-        1.0,
-        faer::Par::Seq,
-    );
-    xs.iter()
-        .zip(bs)
-        .enumerate()
-        .map(|(k, (x, b))| {
-            let d: Vec<f64> = dm.col(k).iter().copied().collect();
-            let mut r = b.clone();
-            for (i, &cls) in classes.iter().enumerate() {
-                let [nu, t] = c.equations(i, cls);
-                r[i] -= nu.eval(x, &d);
-                r[c.p + i] -= t.eval(x, &d);
-            }
-            (r, d)
-        })
+    let cols: Vec<&[f64]> = xs.iter().map(|x| &x[..]).collect();
+    crate::dense::mat_mul(w, &cols)
+        .into_iter()
+        .zip(xs.iter().zip(bs))
+        .map(|(d, (x, b))| (residual_rows(c, classes, x, &d, b), d))
         .collect()
 }
 
