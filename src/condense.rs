@@ -16,9 +16,11 @@
 //! `P A Pᵀ = L Lᵀ` the trailing s × s block `L_SS` of the factor gives
 //! `(A⁻¹)_SS = (L_SS L_SSᵀ)⁻¹` and `W = Zᵀ Z` with `Z = L_SS⁻¹ B_Sᵀ`: one dense triangular
 //! solve of size s with 2p columns instead of 2p sparse solves with A. It is used when
-//! `s ≤ TRAILING_MAX_RATIO · 2p` (nodal contact has s ≤ 2p); wider rows (mortar-type B)
-//! fall back to the solves, one multi-right-hand-side solve in blocks of columns. Both
-//! give the same W up to rounding ([`Delassus::w_by_solves`] recomputes it the second way).
+//! `s ≤ TRAILING_MAX_RATIO · 2p` (nodal contact has s ≤ 2p) and its dense work is less
+//! than the solves' (on a slender strip the factor is a thin band and the solves are
+//! cheaper, see `trailing_is_cheaper`); otherwise W comes from the solves, one
+//! multi-right-hand-side solve in blocks of columns. Both give the same W up to rounding
+//! ([`Delassus::w_by_solves`] recomputes it the second way).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::llt::factor::LltError as DenseLltError;
@@ -42,6 +44,19 @@ const BLOCK: usize = 32;
 /// touches is at most this multiple of 2p (the dense `L_SS` then holds at most
 /// `(2 · 2p)²` numbers); otherwise by 2p solves.
 pub const TRAILING_MAX_RATIO: usize = 2;
+
+/// True when forming W from the trailing block (s contact dofs, m = 2p rows of B) costs
+/// fewer floating-point operations than 2p solves with the AMD-ordered factor of
+/// `nnz_l` values: the dense trailing block's factorisation, its triangular solve with
+/// m columns and `Zᵀ Z` (`s³/3 + s² m + s m²`) against a forward and a backward
+/// substitution per column (`4 m nnz(L)`). On a mesh the contact dofs are a small
+/// separator of a large factor (the 308,160-dof mesh, s = 2p = 960: 2e9 against 1e11);
+/// on a slender strip the factor is a thin band and the dense block of all contact dofs
+/// is the expensive part (p = 1920: 1.3e11 against 4e9).
+fn trailing_is_cheaper(s: usize, m: usize, nnz_l: usize) -> bool {
+    let (s, m) = (s as f64, m as f64);
+    s * s * s / 3.0 + s * s * m + s * m * m <= 4.0 * m * nnz_l as f64
+}
 
 /// Wall-clock times of the set-up phases, in seconds, and the size of the factor.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -250,7 +265,9 @@ impl Delassus {
             touched[j] = true;
         }
         let s = touched.iter().filter(|&&t| t).count();
-        let trailing = s > 0 && s <= TRAILING_MAX_RATIO * b.nrows().max(1);
+        let trailing = s > 0
+            && s <= TRAILING_MAX_RATIO * b.nrows().max(1)
+            && trailing_is_cheaper(s, b.nrows(), amd.len_val());
         let symbolic = if trailing {
             // AMD order of the others, then the touched dofs (in AMD order) last.
             let amd_fwd: Vec<usize> = match amd.perm() {
@@ -1029,20 +1046,7 @@ impl Delassus {
         x_lo.fill(0.0);
         let mut last = vec![f64::INFINITY; k];
         for _ in 0..REFINE_ROUNDS {
-            for c in 0..k {
-                let (xc, lc) = (&x[c * n..(c + 1) * n], &x_lo[c * n..(c + 1) * n]);
-                for i in 0..n {
-                    // rhs_i − Σ_j a_ij (x_j + x_lo,j), compensated
-                    let (mut s, mut e) = (rhs[c * n + i], 0.0f64);
-                    for (j, v) in a.row(i) {
-                        let (p, pe) = two_prod(-v, xc[j]);
-                        let (s2, se) = two_sum(s, p);
-                        s = s2;
-                        e += pe + se - v * lc[j];
-                    }
-                    r[c * n + i] = s + e;
-                }
-            }
+            residual_dd(a, rhs, x, x_lo, r, n);
             self.solve_scaled(MatMut::from_column_major_slice_mut(r, n, k))?;
             let mut more = false;
             for c in 0..k {
@@ -1107,6 +1111,71 @@ impl RefineBuffers {
             r: try_vec(n * k, 0.0, what)?,
         })
     }
+}
+
+/// `r = rhs − A (x + x_lo)` for the n-long columns of `rhs`, `x`, `x_lo` and `r`
+/// (column-major), compensated in double-double and rounded to double. Four columns
+/// share each pass over a row of A (independent chains); compiled for the machine's
+/// fused multiply-adds by faer's dispatch (elsewhere `mul_add` is a library call).
+fn residual_dd(a: &CsrMatrix, rhs: &[f64], x: &[f64], x_lo: &[f64], r: &mut [f64], n: usize) {
+    struct Residual<'a> {
+        a: &'a CsrMatrix,
+        rhs: &'a [f64],
+        x: &'a [f64],
+        x_lo: &'a [f64],
+        r: &'a mut [f64],
+        n: usize,
+    }
+    impl<'a> faer::traits::pulp::WithSimd for Residual<'a> {
+        type Output = ();
+        #[inline(always)]
+        fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) {
+            const L: usize = 4;
+            let Residual {
+                a,
+                rhs,
+                x,
+                x_lo,
+                r,
+                n,
+            } = self;
+            let (ptr, idx, val) = (a.row_ptr(), a.col_idx(), a.values());
+            let k = rhs.len() / n;
+            let mut c0 = 0;
+            while c0 < k {
+                let lanes = L.min(k - c0);
+                let col = |v: &'a [f64], l: usize| &v[(c0 + l.min(lanes - 1)) * n..][..n];
+                let xs: [&[f64]; L] = std::array::from_fn(|l| col(x, l));
+                let ls: [&[f64]; L] = std::array::from_fn(|l| col(x_lo, l));
+                for i in 0..n {
+                    // rhs_i − Σ_j a_ij (x_j + x_lo,j), compensated, in L columns at once
+                    let mut s: [f64; L] = std::array::from_fn(|l| col(rhs, l)[i]);
+                    let mut e = [0.0f64; L];
+                    for q in ptr[i]..ptr[i + 1] {
+                        let (j, v) = (idx[q], val[q]);
+                        for l in 0..L {
+                            let (p, pe) = two_prod(-v, xs[l][j]);
+                            let (s2, se) = two_sum(s[l], p);
+                            s[l] = s2;
+                            e[l] += pe + se - v * ls[l][j];
+                        }
+                    }
+                    for l in 0..lanes {
+                        r[(c0 + l) * n + i] = s[l] + e[l];
+                    }
+                }
+                c0 += lanes;
+            }
+        }
+    }
+    faer::traits::pulp::Arch::new().dispatch(Residual {
+        a,
+        rhs,
+        x,
+        x_lo,
+        r,
+        n,
+    })
 }
 
 /// `Σ v_j (x_j + x_lo,j)` over a sparse row, in double-double (compensated: the products'
