@@ -60,12 +60,31 @@ impl Path {
         let m = 2 * self.problem.p();
         // The piece's own point at the entry α where it was solved for (it may differ from
         // the transition point by cond · ε on an ill-conditioned piece): the guards are
-        // measured there, on the line the exit point is then taken from.
-        let lam0 = cur
-            .xp
-            .as_deref()
-            .cloned()
-            .unwrap_or_else(|| cur.lam.clone());
+        // measured there, on the line the exit point is then taken from. In extended
+        // precision, that point and the piece's direction refined in double-double
+        // (rounded): on a piece so ill-conditioned that cond · ε is visible in its guards
+        // (1e-4 of λ on the p = 1920 strip), the double-precision point made a guard
+        // crossed at the piece's entry and the exit went backwards.
+        let refined = self.refine_piece(cur);
+        let (lam0, t, rate) = match &refined {
+            Some(r) => {
+                let [lam_e, d_e, lam_1, d_1] = &r.rounded;
+                let ta = cur.t[m];
+                self.prime_gaps(cur.alpha, lam_e, d_e.clone());
+                let mut t: Vec<f64> = lam_1.iter().map(|v| v * ta).collect();
+                t.push(ta);
+                let rate: Vec<f64> = d_1.iter().map(|v| v * ta).collect();
+                (lam_e.clone(), t, rate)
+            }
+            None => (
+                cur.xp
+                    .as_deref()
+                    .cloned()
+                    .unwrap_or_else(|| cur.lam.clone()),
+                cur.t.clone(),
+                cur.rate.to_vec(),
+            ),
+        };
         let pt = self.point_at(lam0, cur.alpha)?;
         // The thresholds are those of the transition point (computed, row by row, when
         // the path joined the piece there; the two points differ by rounding only).
@@ -73,7 +92,7 @@ impl Path {
             lam: cur.lam.clone(),
             ..pt.clone()
         });
-        let table = self.guard_table(&cur.classes, &pt, Some((&cur.t, &cur.rate)));
+        let table = self.guard_table(&cur.classes, &pt, Some((&t, &rate)));
         let mut best: Option<(f64, Guard)> = None;
         let mut decreasing = Vec::new();
         let c = self.consts();
@@ -156,9 +175,10 @@ impl Path {
                             .sum::<f64>()
                         - row[m] * cur.alpha;
                     // The piece's point at the entry α was solved from the data with the
-                    // tangent (updated factorisations); else one particular solve.
-                    let xp = if let Some(xp) = &cur.xp {
-                        let mut x = xp.to_vec();
+                    // tangent (updated factorisations) or refined; else one particular
+                    // solve.
+                    let xp = if refined.is_some() || cur.xp.is_some() {
+                        let mut x = pt.lam.clone();
                         x.push(cur.alpha);
                         x
                     } else {
@@ -174,22 +194,25 @@ impl Path {
                         )
                     };
                     let dot = |x: &[f64]| row.iter().zip(x).map(|(a, b)| a * b).sum::<f64>();
-                    let tau = (-c0 - dot(&xp)) / dot(&cur.t);
-                    let x: Vec<f64> = xp.iter().zip(&cur.t).map(|(a, b)| a + tau * b).collect();
+                    let tau = (-c0 - dot(&xp)) / dot(&t);
+                    let x: Vec<f64> = xp.iter().zip(&t).map(|(a, b)| a + tau * b).collect();
                     if x.iter().all(|v| v.is_finite()) {
                         (x[..m].to_vec(), x[m])
                     } else {
-                        let lam = pt.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
-                        (lam, cur.alpha + s * cur.t[m])
+                        let lam = pt.lam.iter().zip(&t).map(|(l, t)| l + s * t).collect();
+                        (lam, cur.alpha + s * t[m])
                     }
                 } else {
-                    let lam = pt.lam.iter().zip(&cur.t).map(|(l, t)| l + s * t).collect();
+                    let lam = pt.lam.iter().zip(&t).map(|(l, t)| l + s * t).collect();
                     (lam, cur.alpha)
                 };
                 // In extended precision, the same exit in double-double where it lies
                 // near this one (a piece too ill-conditioned for the refinement keeps
                 // the double-precision point).
-                let (lam, alpha, g) = match self.polish_exit(cur, &decreasing) {
+                let polished = refined
+                    .as_ref()
+                    .and_then(|r| self.polish_exit(cur, r, &decreasing));
+                let (lam, alpha, g) = match polished {
                     Some((l2, a2, g2)) if super::polish::near(&l2, &lam) => (l2, a2, g2),
                     _ => (lam, alpha, g),
                 };

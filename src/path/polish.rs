@@ -24,8 +24,11 @@ const MAX_ROUNDS: usize = 8;
 const CONVERGED: f64 = 1e-24;
 /// A refinement that stops contracting is kept when its last correction is this small.
 const STALLED: f64 = 1e-20;
-/// A correction larger than this (relative to the solution) ends the refinement as failed.
-const ROUGH: f64 = 1e-4;
+/// A correction larger than this (relative to the solution) ends the refinement as failed:
+/// the guess, a double-precision solution, is then not within cond · ε of the piece's
+/// (garbage from a nearly singular piece). On the p = 1920 strip, cond · ε reaches 1e-4
+/// of λ, and the refinement still contracts by that factor per round.
+const ROUGH: f64 = 1e-2;
 /// See [`near`].
 const NEAR: f64 = 1e-5;
 
@@ -214,6 +217,17 @@ impl Refiner<'_> {
     }
 }
 
+/// A straight piece refined in double-double ([`Path::refine_piece`]): its point at the
+/// entry α and its rate dλ/dα, each with its d, and the four rounded to double (in that
+/// order).
+pub(super) struct RefinedPiece {
+    lam_e: DdVec,
+    d_e: DdVec,
+    lam_1: DdVec,
+    d_1: DdVec,
+    pub(super) rounded: [Vec<f64>; 4],
+}
+
 /// A double-double point `lam2` is taken for the double-precision one `lam` only where
 /// the two lie within [`NEAR`] of each other (relative to max|λ|): what double precision
 /// gets wrong on a slender body is ~1e-7 at most (in α, and so in λ along the piece); a
@@ -298,24 +312,18 @@ impl Path {
         (out.iter().all(|v| v.is_finite()) && near(&out, lam)).then_some(out)
     }
 
-    /// The exit of the straight piece `cur` (affine load, α moving) through the first of
-    /// `decreasing` to reach zero, in double-double: `(λ, α, guard)` rounded to double.
-    /// None when the problem is not carried beyond double, or when the refinement does
-    /// not converge (the piece is too ill-conditioned even for it): the caller then keeps
-    /// its double-precision point.
-    pub(super) fn polish_exit(
-        &mut self,
-        cur: &CurrentPiece,
-        decreasing: &[Guard],
-    ) -> Option<(Vec<f64>, f64, Guard)> {
-        if decreasing.is_empty() || cur.scales.is_vertical(&cur.t) {
+    /// The straight piece `cur` (affine load, α moving) refined in double-double: its
+    /// point at the entry α (from the piece's own point `cur.xp`, else the transition
+    /// point) and its rate dλ/dα, each with its d. None when the problem is not carried
+    /// beyond double, the piece is vertical, or the refinement does not converge (the
+    /// piece is too ill-conditioned even for it): the caller then works in double.
+    pub(super) fn refine_piece(&mut self, cur: &CurrentPiece) -> Option<RefinedPiece> {
+        if cur.scales.is_vertical(&cur.t) {
             return None;
         }
         let m = 2 * self.problem.p();
         let problem = self.problem.clone();
         let r = self.refiner(&problem, &cur.classes, &cur.lu)?;
-        let c = &r.c;
-        let alpha_e = cur.alpha;
         let start = match &cur.xp {
             Some(xp) => xp.to_vec(),
             None => cur.lam.clone(),
@@ -324,20 +332,48 @@ impl Path {
         let rate0: Vec<f64> = cur.t[..m].iter().map(|v| v / ta).collect();
         let mut refined = r
             .refine_all(vec![
-                (DdVec::from(&start), r.point_constant(alpha_e)),
+                (DdVec::from(&start), r.point_constant(cur.alpha)),
                 (DdVec::from(&rate0), r.rate_constant()),
             ])?
             .into_iter();
         let (lam_e, d_e) = refined.next()?;
         let (lam_1, d_1) = refined.next()?;
+        let round = |v: &DdVec| -> Vec<f64> { (0..m).map(|k| v.get(k).to_f64()).collect() };
+        let rounded = [round(&lam_e), round(&d_e), round(&lam_1), round(&d_1)];
+        rounded
+            .iter()
+            .all(|v| v.iter().all(|x| x.is_finite()))
+            .then_some(RefinedPiece {
+                lam_e,
+                d_e,
+                lam_1,
+                d_1,
+                rounded,
+            })
+    }
+
+    /// The exit of the refined straight piece `r` of `cur` through the first of
+    /// `decreasing` to reach zero, in double-double: `(λ, α, guard)` rounded to double.
+    /// None when no guard of `decreasing` decreases in double-double or the exit lies
+    /// outside the window: the caller then keeps its double-precision point.
+    pub(super) fn polish_exit(
+        &self,
+        cur: &CurrentPiece,
+        r: &RefinedPiece,
+        decreasing: &[Guard],
+    ) -> Option<(Vec<f64>, f64, Guard)> {
+        let m = 2 * self.problem.p();
+        let c = self.consts();
+        let alpha_e = cur.alpha;
+        let ta = cur.t[m];
         let dir = if ta > 0.0 { 1.0 } else { -1.0 };
         // Every decreasing guard's zero, s = −γ(α_e)/γ' (α − α_e = s, with the sign of
         // the direction of travel).
         let mut best: Option<(Dd, Guard)> = None;
         for &g in decreasing {
             let f = c.guard_form(g);
-            let v = eval_dd(&f, &lam_e, &d_e);
-            let slope = eval_dd(&f, &lam_1, &d_1);
+            let v = eval_dd(&f, &r.lam_e, &r.d_e);
+            let slope = eval_dd(&f, &r.lam_1, &r.d_1);
             if dir * slope.hi >= 0.0 {
                 continue;
             }
@@ -356,7 +392,7 @@ impl Path {
             return None;
         }
         let lam: Vec<f64> = (0..m)
-            .map(|k| (lam_e.get(k) + lam_1.get(k) * s).to_f64())
+            .map(|k| (r.lam_e.get(k) + r.lam_1.get(k) * s).to_f64())
             .collect();
         (alpha.is_finite() && lam.iter().all(|v| v.is_finite())).then_some((lam, alpha, g))
     }
