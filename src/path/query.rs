@@ -216,8 +216,10 @@ impl Path {
     /// Every traced solution at `alpha`: one per traced piece whose α-range contains it
     /// (several past a fold), each by interpolation between the piece's end points for an
     /// affine load (exact: a piece is then a segment), or one solve with the piece matrix
-    /// (O(m³)) otherwise, plus one back-solve for u. Points shared by two pieces (transition points) are reported
-    /// once. Empty if the traced path never reached `alpha`. Errors: not started, load
+    /// otherwise (O(k m²) by an update of the path's current factorisation when the piece
+    /// differs from it in k ≤ m/8 nodes, checked against the data; O(m³) by a fresh LU
+    /// beyond that), plus one back-solve for u. Points shared by two pieces (transition
+    /// points) are reported once. Empty if the traced path never reached `alpha`. Errors: not started, load
     /// failure.
     pub fn solutions_at(&mut self, alpha: f64) -> Result<Vec<Solution>> {
         let pieces = self.trace_ref()?.pieces.clone();
@@ -259,10 +261,24 @@ impl Path {
                     .collect();
                 lams.push(self.lam_to_internal(&lam));
             } else {
+                // One solve on the piece: by an update of the path's factorisation where
+                // the piece differs from its base in few nodes (O(k m²)), checked against
+                // the data; else (or when the check fails) a fresh LU (O(m³)).
                 let c = self.consts();
                 let w = self.problem.delassus().w();
-                let lu = DenseLu::new(c.piece_matrix(w, &pc.classes).as_ref());
-                lams.push(lu.solve(&c.piece_rhs(&pc.classes, &qg)));
+                let rhs = c.piece_rhs(&pc.classes, &qg);
+                let updated = self
+                    .updater
+                    .borrow()
+                    .as_ref()
+                    .filter(|u| u.updates() + u.differences(&pc.classes) <= update::max_updates(m))
+                    .and_then(|u| u.extend(&c, w, &pc.classes, None, &[]))
+                    .map(|(u, _)| u.solve_checked(&c, w, &rhs, self.row_bound()))
+                    .filter(|k| k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()))
+                    .map(|k| k.x);
+                lams.push(updated.unwrap_or_else(|| {
+                    DenseLu::new(c.piece_matrix(w, &pc.classes).as_ref()).solve(&rhs)
+                }));
             }
             for lam in lams {
                 let pt = Point {
