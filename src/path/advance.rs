@@ -21,6 +21,10 @@ pub(super) enum Exit {
     Guards(Point, Vec<Guard>),
 }
 
+/// Every this many transitions the exit point's d is computed from W afresh instead of
+/// from the piece's point along its line (see [`Path::exit_linear`]).
+const GAPS_REFRESH: usize = 8;
+
 impl Path {
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
     /// with the rate of d along it (`W t_λ + q' t_α`, see [`Path::rate_along`]).
@@ -153,6 +157,9 @@ impl Path {
                 Ok(Exit::Window(Point { lam, ..pt }))
             }
             (Some((s, g)), _) => {
+                // The exit's distance τ along t from the piece's point `pt` where the
+                // exit lies on that line: its d is then `d(pt) + τ · rate` (O(m)).
+                let mut on_line: Option<f64> = None;
                 let (lam, alpha) = if self.load.is_affine() {
                     // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
                     // piece's factorisation) and τ from the guard's equation; no drift
@@ -197,8 +204,12 @@ impl Path {
                     let tau = (-c0 - dot(&xp)) / dot(&t);
                     let x: Vec<f64> = xp.iter().zip(&t).map(|(a, b)| a + tau * b).collect();
                     if x.iter().all(|v| v.is_finite()) {
+                        if refined.is_some() || cur.xp.is_some() {
+                            on_line = Some(tau);
+                        }
                         (x[..m].to_vec(), x[m])
                     } else {
+                        on_line = Some(s);
                         let lam = pt.lam.iter().zip(&t).map(|(l, t)| l + s * t).collect();
                         (lam, cur.alpha + s * t[m])
                     }
@@ -213,9 +224,47 @@ impl Path {
                     .as_ref()
                     .and_then(|r| self.polish_exit(cur, r, &decreasing));
                 let (lam, alpha, g) = match polished {
-                    Some((l2, a2, g2)) if super::polish::near(&l2, &lam) => (l2, a2, g2),
+                    Some((l2, a2, g2)) if super::polish::near(&l2, &lam) => {
+                        on_line = None;
+                        (l2, a2, g2)
+                    }
                     _ => (lam, alpha, g),
                 };
+                // The exit's d from the piece's point along the line instead of a product
+                // with W (at p = 1920 that pass was 45 % of a transition). Each such d
+                // carries the rounding of the one before it, so every GAPS_REFRESH-th
+                // transition computes it afresh from W: the drift stays within a few
+                // roundings of |W||λ|, far below the thresholds.
+                let transitions = self.trace.as_ref().map_or(0, |tr| tr.transitions);
+                if let Some(tau) = on_line
+                    && !transitions.is_multiple_of(GAPS_REFRESH)
+                {
+                    // Row k is kept where its rounding, ε (|d_k(pt)| + |τ rate_k|), is within
+                    // a few of the product's own, ε (|W||λ|)_k ≥ ε |(W λ)_k|; elsewhere
+                    // (cancellation along a long piece) it is the row of the product (O(m)).
+                    let d0 = self.gaps(&pt);
+                    let q = self.load.q(alpha, self.problem.delassus()).ok();
+                    if let Some((qa, _)) = q {
+                        let qg = shift_gap(&qa, self.problem.gap_equilibrated());
+                        let w = self.problem.delassus().w();
+                        let d: Vec<f64> = (0..m)
+                            .map(|k| {
+                                let v = d0[k] + tau * rate[k];
+                                let step = d0[k].abs() + (tau * rate[k]).abs();
+                                if step <= 4.0 * ((v - qg[k]).abs() + qg[k].abs()) {
+                                    v
+                                } else {
+                                    // row k of the symmetric W, read as its column k
+                                    qg[k]
+                                        + w.col(k).iter().zip(&lam).map(|(a, b)| a * b).sum::<f64>()
+                                }
+                            })
+                            .collect();
+                        if d.iter().all(|v| v.is_finite()) {
+                            self.prime_gaps(alpha, &lam, d);
+                        }
+                    }
+                }
                 let pt = self.point_at(lam, alpha)?;
                 Ok(Exit::Guards(pt, vec![g]))
             }
