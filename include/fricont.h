@@ -1018,9 +1018,10 @@ fricont_status fricont_problem_extended_precision(struct fricont_problem *proble
 
 /**
  * Validates and factorises the problem now: checks the symmetry of A (full storage),
- * computes a sparse Cholesky factorisation of A (the dofs B touches ordered last) and the
- * Delassus operator W = B A⁻¹ Bᵀ from the trailing block of the factor (or by 2p solves
- * when B's rows are wide, or with the host's solve; a condensed W is checked instead),
+ * computes a sparse Cholesky factorisation of A and the Delassus operator W = B A⁻¹ Bᵀ:
+ * from the trailing block of the factor (the dofs B touches ordered last) where that is
+ * cheaper, by 2p solves with an AMD-ordered factor where they are (slender bodies, wide
+ * rows of B), or with the host's solve; a condensed W is checked instead;
  * and checks that W is positive definite (B = [N; T] of full row rank). Extreme but
  * valid scales of A work (entries of 1e300 or 1e-310, with loads of the same size): an
  * A whose largest entry lies outside [2^-64, 2^64] is factorised as 2^k A (exact, k

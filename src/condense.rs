@@ -42,7 +42,8 @@ const BLOCK: usize = 32;
 
 /// W is formed from the trailing block of the factor when the number s of dofs that B
 /// touches is at most this multiple of 2p (the dense `L_SS` then holds at most
-/// `(2 · 2p)²` numbers); otherwise by 2p solves.
+/// `(2 · 2p)²` numbers) and its dense work is less than the solves' (see
+/// `trailing_is_cheaper`); otherwise by 2p solves.
 pub const TRAILING_MAX_RATIO: usize = 2;
 
 /// True when forming W from the trailing block (s contact dofs, m = 2p rows of B) costs
@@ -425,7 +426,8 @@ impl Delassus {
     }
 
     /// `W = B A⁻¹ Bᵀ` by 2p solves with the factor of A, in blocks of columns: how W is
-    /// formed when B's rows are wide, and an independent check of the trailing-block W
+    /// formed when B's rows are wide or the solves cost less than the trailing block's
+    /// dense work (slender bodies), and an independent check of the trailing-block W
     /// (the two agree to rounding: ~1e-13 relative). Errors: a host's solve failed;
     /// [`Error::NoDisplacement`] for condensed input (no A⁻¹).
     pub fn w_by_solves(&self) -> Result<Mat<f64>> {
@@ -529,7 +531,8 @@ impl Delassus {
     }
 
     /// True when W was formed from the trailing block of the factor (the dofs that B
-    /// touches ordered last), false when by 2p solves (wide rows of B).
+    /// touches ordered last), false when by 2p solves (wide rows of B, or a factor so thin
+    /// that the solves cost less).
     pub fn w_from_trailing_block(&self) -> bool {
         self.z.is_some()
     }
