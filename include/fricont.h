@@ -978,7 +978,7 @@ fricont_status fricont_problem_set_threads(struct fricont_problem *problem,
  * (residuals in double-double, about four solves with the factor per column of Bᵀ at
  * the build, and 2p × 2p more doubles of memory). Auto refines when an estimate of the
  * 2-norm condition number of the equilibrated W exceeds 1e7 and the refinement's
- * estimated cost is at most max(20 × the factorisation's, 5e10 floating-point
+ * estimated cost is at most max(20 × the factorisation's, 1e11 floating-point
  * operations); off never. A problem made from condensed data (`fricont_problem_new_condensed`)
  * is never refined (its W is the caller's data); with on (or auto and an ill-conditioned
  * W) it is traced in extended precision all the same. Like the friction, a change drops

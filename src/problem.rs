@@ -367,8 +367,8 @@ pub enum ExtendedPrecision {
     /// Refine when W is ill-conditioned and refining is affordable: the estimate
     /// [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e7) and the
     /// refinement's estimated floating-point operations (about `2p · (16 nnz(L) + 36
-    /// nnz(A))`) are at most `max(20 × the factorisation's, 5e10)` ([`AUTO_COST_FLOPS`]:
-    /// about 5 s on one core). A host's solve is never refined; condensed input counts as extended when its
+    /// nnz(A))`) are at most `max(20 × the factorisation's, 1e11)` ([`AUTO_COST_FLOPS`]:
+    /// about 10 s on one core). A host's solve is never refined; condensed input counts as extended when its
     /// W is ill-conditioned (the tracer then works in double-double with the caller's W).
     #[default]
     Auto,
@@ -389,13 +389,14 @@ pub const AUTO_CONDITION: f64 = 1e7;
 /// operations are at most `max(AUTO_COST_RATIO × the factorisation's, AUTO_COST_FLOPS)`.
 pub const AUTO_COST_RATIO: f64 = 20.0;
 
-/// The absolute budget of [`ExtendedPrecision::Auto`] in floating-point operations (5e10,
-/// about 5 s on one core), see [`AUTO_COST_RATIO`]. Slender strips factorise in almost no
-/// time, so the ratio alone would refuse them, while their refinement stays within the
-/// time of tracing them: the p = 480 strip of `cli/benches/strips.rs` (estimate 4e10)
-/// refines in about 4 s and traces in about 8 s. A 308,160-dof mesh with p = 480 would
-/// need 8e11 (44 × its factorisation).
-pub const AUTO_COST_FLOPS: f64 = 5e10;
+/// The absolute budget of [`ExtendedPrecision::Auto`] in floating-point operations (1e11,
+/// about 10 s on one core), see [`AUTO_COST_RATIO`]. Slender strips factorise in almost no
+/// time, so the ratio alone would refuse them, while their refinement stays well within
+/// the time of tracing them: the p = 1920 strip of `cli/benches/strips.rs` (κ(W) ≈ 4e11,
+/// estimate 5.6e10) refines in about 6.5 s and traces in about 10 min; in double its
+/// pieces' points would be off by up to κ ε ≈ 4e-5 relative. A 308,160-dof mesh with p = 480
+/// would need 8e11 (44 × its factorisation).
+pub const AUTO_COST_FLOPS: f64 = 1e11;
 
 /// Where the operator `A⁻¹` and `W` come from.
 #[derive(Debug, Clone)]
