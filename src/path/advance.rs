@@ -160,6 +160,9 @@ impl Path {
                 // The exit's distance τ along t from the piece's point `pt` where the
                 // exit lies on that line: its d is then `d(pt) + τ · rate` (O(m)).
                 let mut on_line: Option<f64> = None;
+                // Whether the line starts at `pt` itself (the piece's solved or refined
+                // point), not at a particular solution elsewhere on it.
+                let from_pt = refined.is_some() || cur.xp.is_some();
                 let (lam, alpha) = if self.load.is_affine() {
                     // Exact point from the data: x = x_p + τ t with J x_p = rhs (from the
                     // piece's factorisation) and τ from the guard's equation; no drift
@@ -184,7 +187,7 @@ impl Path {
                     // The piece's point at the entry α was solved from the data with the
                     // tangent (updated factorisations) or refined; else one particular
                     // solve.
-                    let xp = if refined.is_some() || cur.xp.is_some() {
+                    let xp = if from_pt {
                         let mut x = pt.lam.clone();
                         x.push(cur.alpha);
                         x
@@ -204,7 +207,7 @@ impl Path {
                     let tau = (-c0 - dot(&xp)) / dot(&t);
                     let x: Vec<f64> = xp.iter().zip(&t).map(|(a, b)| a + tau * b).collect();
                     if x.iter().all(|v| v.is_finite()) {
-                        if refined.is_some() || cur.xp.is_some() {
+                        if from_pt {
                             on_line = Some(tau);
                         }
                         (x[..m].to_vec(), x[m])
@@ -235,6 +238,7 @@ impl Path {
                 // carries the rounding of the one before it, so every GAPS_REFRESH-th
                 // transition computes it afresh from W: the drift stays within a few
                 // roundings of |W||λ|, far below the thresholds.
+                let exit = self.point_at(lam, alpha)?;
                 let transitions = self.trace.as_ref().map_or(0, |tr| tr.transitions);
                 if let Some(tau) = on_line
                     && !transitions.is_multiple_of(GAPS_REFRESH)
@@ -243,30 +247,30 @@ impl Path {
                     // a few of the product's own, ε (|W||λ|)_k ≥ ε |(W λ)_k|; elsewhere
                     // (cancellation along a long piece) it is the row of the product (O(m)).
                     let d0 = self.gaps(&pt);
-                    let q = self.load.q(alpha, self.problem.delassus()).ok();
-                    if let Some((qa, _)) = q {
-                        let qg = shift_gap(&qa, self.problem.gap_equilibrated());
-                        let w = self.problem.delassus().w();
-                        let d: Vec<f64> = (0..m)
-                            .map(|k| {
-                                let v = d0[k] + tau * rate[k];
-                                let step = d0[k].abs() + (tau * rate[k]).abs();
-                                if step <= 4.0 * ((v - qg[k]).abs() + qg[k].abs()) {
-                                    v
-                                } else {
-                                    // row k of the symmetric W, read as its column k
-                                    qg[k]
-                                        + w.col(k).iter().zip(&lam).map(|(a, b)| a * b).sum::<f64>()
-                                }
-                            })
-                            .collect();
-                        if d.iter().all(|v| v.is_finite()) {
-                            self.prime_gaps(alpha, &lam, d);
-                        }
+                    let qg = shift_gap(&exit.q, self.problem.gap_equilibrated());
+                    let w = self.problem.delassus().w();
+                    let d: Vec<f64> = (0..m)
+                        .map(|k| {
+                            let v = d0[k] + tau * rate[k];
+                            let step = d0[k].abs() + (tau * rate[k]).abs();
+                            if step <= 4.0 * ((v - qg[k]).abs() + qg[k].abs()) {
+                                v
+                            } else {
+                                // row k of the symmetric W, read as its column k
+                                qg[k]
+                                    + w.col(k)
+                                        .iter()
+                                        .zip(&exit.lam)
+                                        .map(|(a, b)| a * b)
+                                        .sum::<f64>()
+                            }
+                        })
+                        .collect();
+                    if d.iter().all(|v| v.is_finite()) {
+                        self.prime_gaps(exit.alpha, &exit.lam, d);
                     }
                 }
-                let pt = self.point_at(lam, alpha)?;
-                Ok(Exit::Guards(pt, vec![g]))
+                Ok(Exit::Guards(exit, vec![g]))
             }
             (None, Some(_)) => unreachable!("handled by the window arm"),
         }
