@@ -181,11 +181,10 @@ impl<'a> PieceSolves<'a> {
     /// As [`solve_piece`].
     fn solve(&mut self, classes: &[Class], qg: &[f64]) -> Option<Vec<f64>> {
         let rhs = self.c.piece_rhs(classes, qg);
-        let m = 2 * self.c.p;
         let extended = self
             .lu
             .as_ref()
-            .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
+            .filter(|u| u.reaches(classes))
             .and_then(|u| u.extend(self.c, self.w, classes, None, &[]))
             .map(|(u, _)| u);
         if let Some(u) = extended {

@@ -965,7 +965,7 @@ impl Path {
             .updater
             .borrow()
             .as_ref()
-            .filter(|u| u.updates() + u.differences(classes) <= update::max_updates(m))
+            .filter(|u| u.reaches(classes))
             .and_then(|u| u.extend(&c, w, classes, Some(&neg), std::slice::from_ref(&resid)));
         let on_update = |(mut u, dx): (UpdatedLu, Vec<Vec<f64>>)| {
             // W times the point's correction and the carried tangent: one pass over W.

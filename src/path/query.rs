@@ -271,7 +271,7 @@ impl Path {
                     .updater
                     .borrow()
                     .as_ref()
-                    .filter(|u| u.updates() + u.differences(&pc.classes) <= update::max_updates(m))
+                    .filter(|u| u.reaches(&pc.classes))
                     .and_then(|u| u.extend(&c, w, &pc.classes, None, &[]))
                     .map(|(u, _)| u.solve_checked(&c, w, &rhs, self.row_bound()))
                     .filter(|k| k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()))

@@ -208,6 +208,13 @@ impl UpdatedLu {
         self.updates.len()
     }
 
+    /// True when `classes` can be reached by updates of this base: the updates so far and
+    /// the nodes whose class differs stay within [`max_updates`] (else a fresh base is
+    /// factorised).
+    pub fn reaches(&self, classes: &[Class]) -> bool {
+        self.updates() + self.differences(classes) <= max_updates(2 * self.classes.len())
+    }
+
     /// Nodes whose class differs from `classes`.
     pub fn differences(&self, classes: &[Class]) -> usize {
         self.classes
