@@ -4,7 +4,14 @@
 //! cargo bench --bench trace                 # tests/data/sample-rect30
 //! cargo bench --bench trace -- DIR          # another problem directory
 //! FRICONT_BENCH_CASE=DIR FRICONT_BENCH_REPS=15 cargo bench --bench trace
+//! FRICONT_BENCH_LOAD=basis-sine cargo bench --bench trace -- DIR
 //! ```
+//!
+//! `FRICONT_BENCH_LOAD` chooses the load: `affine` (default: the directory's f0 + α f1),
+//! or the oscillating `f0 + φ(α) f1`, `φ(α) = α + A sin(2π·10 (α − α_start)/L)` with
+//! L the window's length and A = L/100 (ten periods over the window), given as a basis
+//! load (`basis-sine`: vectors f0, f1 and the weights) or as a general load
+//! (`general-sine`: f itself, condensed at every α).
 //!
 //! Set-up = building the problem (validation, sparse Cholesky of A, W = B A⁻¹ Bᵀ) and
 //! binding the load (condensed load vectors). Trace = the start solve plus every step to
@@ -17,6 +24,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Instant;
 
+use fricont::load::{Load, LoadFailure};
 use fricont::path::{Path, PathOptions};
 use fricont_exchange::io::CaseData;
 
@@ -56,6 +64,44 @@ fn main() {
     };
     let read_s = t.elapsed().as_secs_f64();
     let opts = PathOptions::window(case.alpha_start, case.alpha_end);
+    let kind = std::env::var("FRICONT_BENCH_LOAD").unwrap_or_else(|_| "affine".into());
+    let (a_start, len) = (case.alpha_start, case.alpha_end - case.alpha_start);
+    let (amp, omega) = (len / 100.0, 2.0 * std::f64::consts::PI * 10.0 / len);
+    let load = || -> Load {
+        let (f0, f1) = (case.f0.clone(), case.f1.clone());
+        match kind.as_str() {
+            "basis-sine" => Load::basis(
+                vec![f0, f1],
+                Box::new(move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+                    let x = omega * (a - a_start);
+                    w[0] = 1.0;
+                    w[1] = a + amp * x.sin();
+                    dw[0] = 0.0;
+                    dw[1] = 1.0 + amp * omega * x.cos();
+                    Ok::<(), LoadFailure>(())
+                }),
+            )
+            .expect("load"),
+            "general-sine" => Load::general(
+                f0.len(),
+                Box::new(move |a: f64, out: &mut [f64]| {
+                    let s = a + amp * (omega * (a - a_start)).sin();
+                    for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+                        *o = x + s * y;
+                    }
+                    Ok::<(), LoadFailure>(())
+                }),
+                None,
+            ),
+            "affine" => case.load().expect("load"),
+            other => {
+                eprintln!(
+                    "bench trace: FRICONT_BENCH_LOAD={other}: affine, basis-sine or general-sine"
+                );
+                std::process::exit(2);
+            }
+        }
+    };
 
     let mut setup = Vec::with_capacity(reps);
     let mut trace = Vec::with_capacity(reps);
@@ -64,17 +110,12 @@ fn main() {
     for _ in 0..reps {
         let t = Instant::now();
         let problem = Arc::new(case.problem(None).expect("problem"));
-        let path = Path::new(
-            Arc::clone(&problem),
-            case.load().expect("load"),
-            opts.clone(),
-        )
-        .expect("path");
+        let path = Path::new(Arc::clone(&problem), load(), opts.clone()).expect("path");
         setup.push(t.elapsed().as_secs_f64());
         drop(path);
 
         // A fresh path on the same problem: binding the load is set-up, not trace.
-        let mut path = Path::new(problem, case.load().expect("load"), opts.clone()).expect("path");
+        let mut path = Path::new(problem, load(), opts.clone()).expect("path");
         let t = Instant::now();
         path.start(opts.alpha_start, None).expect("start");
         start.push(t.elapsed().as_secs_f64());
@@ -92,7 +133,7 @@ fn main() {
     let (t_med, t_min) = median_min(&mut trace);
     let (st_med, st_min) = median_min(&mut start);
     println!(
-        "case {} (n = {}, p = {}), {reps} repetitions; {summary}",
+        "case {} (n = {}, p = {}), load {kind}, {reps} repetitions; {summary}",
         dir.display(),
         case.n(),
         case.p()
