@@ -91,7 +91,11 @@ impl Load {
         Ok(Load::Affine { f0, f1 })
     }
 
-    /// `f(α) = Σ_j φ_j(α) f_j`. Errors: no vectors, lengths differ, non-finite entries.
+    /// `f(α) = Σ_j φ_j(α) f_j`, the weights `φ_j(α)`, `φ_j'(α)` from `weights`. Each
+    /// vector is condensed once (one solve with A), and along each piece the solution is
+    /// solved for once per vector, so the evaluations that locate a piece's end cost
+    /// O(k p) each instead of solves with A and the piece matrix (a [`Load::general`]
+    /// load). Errors: no vectors, lengths differ, non-finite entries.
     pub fn basis(vectors: Vec<Vec<f64>>, weights: WeightsFn) -> Result<Load> {
         let Some(first) = vectors.first() else {
             return Err(Error::Dimension("basis load with no vectors".into()));
@@ -282,6 +286,19 @@ impl BoundLoad {
     #[cfg_attr(not(test), allow(dead_code))]
     pub(crate) fn q_lo(&self) -> Option<&[Vec<f64>]> {
         self.q_lo.as_deref()
+    }
+
+    /// For a basis load: its condensed vectors `q_j`, so that `q(α) = Σ_j w_j(α) q_j`.
+    /// None for other loads.
+    pub(crate) fn basis_vectors(&self) -> Option<&[Vec<f64>]> {
+        matches!(self.load, Load::Basis { .. }).then_some(&self.q_basis[..])
+    }
+
+    /// For a basis load whose weights were last evaluated at `alpha` (by [`Self::q`]):
+    /// `(w(α), w'(α))`. None otherwise.
+    pub(crate) fn weights_at(&self, alpha: f64) -> Option<(&[f64], &[f64])> {
+        (matches!(self.load, Load::Basis { .. }) && self.weights_alpha == alpha)
+            .then_some((&self.weights[..], &self.dweights[..]))
     }
 
     /// True when `f` (hence `q`) is affine in α.

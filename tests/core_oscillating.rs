@@ -84,6 +84,9 @@ fn one_node_sine_load_finds_every_transition() {
 /// transition point of the affine path with |φ| < A is met six times (up and down in each
 /// period), at the α where A sin(50 α) equals it. Reference: the same mesh traced under
 /// the affine load `f0 + φ f1` on [−A, A] (fold-free cases only), mapped through asin.
+/// The load is given as a general load (f itself, each α condensed and solved for) and
+/// as a basis load `[f0, f1]` with weights `(1, A sin 50α)` (each piece solved once per
+/// basis vector, the guards along it combined from those solutions).
 #[test]
 fn finite_element_sine_shear_finds_every_transition() {
     let mut checked = 0;
@@ -116,44 +119,60 @@ fn finite_element_sine_shear_finds_every_transition() {
         want.sort_by(|x, y| x.0.total_cmp(&y.0));
         let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
         let n = f0.len();
+        let (g0, g1) = (f0.clone(), f1.clone());
         let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
             let s = amp * (50.0 * al).sin();
-            for ((o, a), b) in out.iter_mut().zip(&f0).zip(&f1) {
+            for ((o, a), b) in out.iter_mut().zip(&g0).zip(&g1) {
                 *o = a + s * b;
             }
             Ok(())
         });
-        let mut path = Path::new(
-            problem,
-            Load::general(n, f, None),
-            PathOptions::window(a0, a0 + 3.0 * period),
-        )
-        .unwrap();
-        path.start(a0, None).unwrap();
-        assert_eq!(path.run().unwrap(), EndReason::Window, "seed {seed}");
-        let got = path.events();
-        assert_eq!(
-            got.len(),
-            want.len(),
-            "seed {seed}: {} events, expected {}",
-            got.len(),
-            want.len()
+        let weights = Box::new(
+            move |al: f64, w: &mut [f64], dw: &mut [f64]| -> Result<(), LoadFailure> {
+                w[0] = 1.0;
+                w[1] = amp * (50.0 * al).sin();
+                dw[0] = 0.0;
+                dw[1] = 50.0 * amp * (50.0 * al).cos();
+                Ok(())
+            },
         );
-        for (g, w) in got.iter().zip(&want) {
-            // compare in φ: the affine event is determined to 1e-12 there
-            let (pg, pw) = (amp * (50.0 * g.alpha).sin(), amp * (50.0 * w.0).sin());
-            assert!(
-                (pg - pw).abs() <= 1e-10,
-                "seed {seed}: φ {pg} expected {pw} (α {} vs {})",
-                g.alpha,
-                w.0
-            );
+        let loads = [
+            ("general", Load::general(n, f, None)),
+            ("basis", Load::basis(vec![f0, f1], weights).unwrap()),
+        ];
+        for (name, load) in loads {
+            let mut path = Path::new(
+                problem.clone(),
+                load,
+                PathOptions::window(a0, a0 + 3.0 * period),
+            )
+            .unwrap();
+            path.start(a0, None).unwrap();
+            assert_eq!(path.run().unwrap(), EndReason::Window, "seed {seed} {name}");
+            let got = path.events();
             assert_eq!(
-                (g.node, g.from, g.to),
-                (w.1, w.2, w.3),
-                "seed {seed} at α {}",
-                w.0
+                got.len(),
+                want.len(),
+                "seed {seed} {name}: {} events, expected {}",
+                got.len(),
+                want.len()
             );
+            for (g, w) in got.iter().zip(&want) {
+                // compare in φ: the affine event is determined to 1e-12 there
+                let (pg, pw) = (amp * (50.0 * g.alpha).sin(), amp * (50.0 * w.0).sin());
+                assert!(
+                    (pg - pw).abs() <= 1e-10,
+                    "seed {seed} {name}: φ {pg} expected {pw} (α {} vs {})",
+                    g.alpha,
+                    w.0
+                );
+                assert_eq!(
+                    (g.node, g.from, g.to),
+                    (w.1, w.2, w.3),
+                    "seed {seed} {name} at α {}",
+                    w.0
+                );
+            }
         }
         checked += 1;
     }

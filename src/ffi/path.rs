@@ -456,7 +456,11 @@ pub unsafe extern "C" fn fricont_path_new_affine(
 
 /// Creates a path with the load `f(α) = Σ_j φ_j(α) f_j`, j = 0..k−1: k fixed vectors with
 /// scalar weights from a callback. One solve per vector at creation; each α then costs
-/// nothing but the callback.
+/// nothing but the callback. Along each piece the solution is solved for once per vector
+/// (k + 1 solves with the piece matrix), and the many evaluations that locate the piece's
+/// end combine those solutions (O(k p) each); a general load (`fricont_path_new_general`)
+/// costs solves with A and with the piece matrix at every evaluation instead. Prefer this
+/// form whenever the load is a combination of a few fixed vectors.
 ///
 /// * `problem`: not NULL (see `fricont_path_new_affine`).
 /// * `vectors`: the k vectors, each of n values, stored one after the other (column-major

@@ -4,6 +4,7 @@
 
 use super::roots::{brent, hermite_min};
 use super::*;
+use crate::dense::axpy;
 
 /// A guard with its value and its derivative along the tangent.
 pub(super) struct GuardRow {
@@ -25,7 +26,65 @@ pub(super) enum Exit {
 /// from the piece's point along its line (see [`Path::exit_linear`]).
 const GAPS_REFRESH: usize = 8;
 
+/// A piece's solutions under a basis load `q(α) = Σ_j w_j(α) q_j`. The piece's right-hand
+/// side is linear in `q − (g, 0)`, so with `y_j = M_S⁻¹ rhs_S(q_j)` and
+/// `y_g = M_S⁻¹ rhs_S(−(g, 0))`: `λ(α) = Σ_j w_j y_j + y_g`, `dλ/dα = Σ_j w'_j y_j`, and
+/// `d = W λ + q − (g, 0)` follows from the products `W y_j`, `W y_g`. J + 1 checked solves
+/// and their products with W once per piece; each evaluation along the piece then costs
+/// O(J m) instead of two solves with `M_S` and two products with W.
+pub(super) struct BasisSolutions {
+    /// `y_1 … y_J`, then `y_g`.
+    y: Vec<Vec<f64>>,
+    /// W times each.
+    wy: Vec<Vec<f64>>,
+}
+
+impl BasisSolutions {
+    /// `(λ, d, dλ/dα, rate of d along (dλ/dα, 1))` for the weights `w`, `w'` at α, with
+    /// `qg = q(α) − (g, 0)` and `dq = q'(α)`.
+    fn at(&self, w: &[f64], dw: &[f64], qg: &[f64], dq: &[f64]) -> [Vec<f64>; 4] {
+        let k = w.len();
+        let mut lam = self.y[k].clone();
+        let mut d: Vec<f64> = qg.iter().zip(&self.wy[k]).map(|(a, b)| a + b).collect();
+        let mut dl = vec![0.0; lam.len()];
+        let mut rate = dq.to_vec();
+        for j in 0..k {
+            axpy(&mut lam, w[j], &self.y[j]);
+            axpy(&mut d, w[j], &self.wy[j]);
+            axpy(&mut dl, dw[j], &self.y[j]);
+            axpy(&mut rate, dw[j], &self.wy[j]);
+        }
+        [lam, d, dl, rate]
+    }
+}
+
 impl Path {
+    /// The [`BasisSolutions`] of the current piece under a basis load, solved by updates of
+    /// the path's factorisation. None for other loads, for the fresh-factorisation tracer
+    /// (which keeps solving at every α, the reference), or when a solve fails its check.
+    fn basis_solutions(&self, cur: &CurrentPiece) -> Option<BasisSolutions> {
+        let PieceSolver::Updated(u) = &*cur.lu else {
+            return None;
+        };
+        let qs = self.load.basis_vectors()?;
+        let c = self.consts();
+        let zeros = vec![0.0; 2 * c.p];
+        let mut rhs: Vec<Vec<f64>> = qs.iter().map(|q| c.piece_rhs(&cur.classes, q)).collect();
+        let g = shift_gap(&zeros, self.problem.gap_equilibrated());
+        rhs.push(c.piece_rhs(&cur.classes, &g));
+        let cols: Vec<update::Rhs<'_>> =
+            rhs.iter().map(|b| update::Rhs { b, guess: None }).collect();
+        let solved = u.solve_checked_many(&c, self.problem.delassus().w(), &cols, self.row_bound());
+        if solved
+            .iter()
+            .any(|s| s.rel > 1e-12 || !s.x.iter().all(|v| v.is_finite()))
+        {
+            return None;
+        }
+        let (y, wy) = solved.into_iter().map(|s| (s.x, s.wx)).unzip();
+        Some(BasisSolutions { y, wy })
+    }
+
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
     /// with the rate of d along it (`W t_λ + q' t_α`, see [`Path::rate_along`]).
     pub(super) fn guard_table(
@@ -34,9 +93,20 @@ impl Path {
         pt: &Point,
         t: Option<(&[f64], &[f64])>,
     ) -> Vec<GuardRow> {
+        let d = self.gaps(pt);
+        self.guard_rows(classes, &pt.lam, &d, t)
+    }
+
+    /// As [`Self::guard_table`], at the point `(λ, d)`.
+    fn guard_rows(
+        &self,
+        classes: &[Class],
+        lam: &[f64],
+        d: &[f64],
+        t: Option<(&[f64], &[f64])>,
+    ) -> Vec<GuardRow> {
         let c = self.consts();
         let m = 2 * c.p;
-        let d = self.gaps(pt);
         let zeros;
         let (lt, dt) = match t {
             Some((t, rate)) => (&t[..m], rate),
@@ -51,7 +121,7 @@ impl Path {
                 let f = c.guard_form(g);
                 GuardRow {
                     guard: g,
-                    value: f.eval(&pt.lam, &d),
+                    value: f.eval(lam, d),
                     slope: f.eval(lt, dt),
                 }
             })
@@ -295,36 +365,53 @@ impl Path {
                 ))
             }
         };
-        let msolve = |this: &Self, b: &[f64]| -> Vec<f64> {
-            match (&dense, &*cur.lu) {
-                (Some(lu), _) => lu.solve(b),
+        // λ, d, dλ/dα and the rate of d along (dλ/dα, 1) from solves with M_S: both
+        // columns in one pass over the factor and one product with W.
+        let solve = |this: &Self, qg: &[f64], dq: &[f64]| -> [Vec<f64>; 4] {
+            let c = this.consts();
+            let w = this.problem.delassus().w();
+            let rhs = [c.piece_rhs(&cur.classes, qg), c.piece_rhs(&cur.classes, dq)];
+            let (xs, wxs) = match (&dense, &*cur.lu) {
+                (Some(lu), _) => {
+                    let xs: Vec<Vec<f64>> = rhs.iter().map(|b| lu.solve(b)).collect();
+                    let wxs = crate::dense::mat_mul(w, &[&xs[0], &xs[1]]);
+                    (xs, wxs)
+                }
                 (None, PieceSolver::Updated(u)) => {
-                    u.solve_checked(
-                        &this.consts(),
-                        this.problem.delassus().w(),
-                        b,
-                        this.row_bound(),
-                    )
-                    .x
+                    let cols = rhs.each_ref().map(|b| update::Rhs { b, guess: None });
+                    u.solve_checked_many(&c, w, &cols, this.row_bound())
+                        .into_iter()
+                        .map(|k| (k.x, k.wx))
+                        .unzip()
                 }
                 (None, PieceSolver::Full(_)) => unreachable!("a full solver has its dense LU"),
-            }
+            };
+            let add = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                a.iter().zip(b).map(|(x, y)| x + y).collect()
+            };
+            let [lam, dl]: [Vec<f64>; 2] = xs.try_into().expect("two columns");
+            [lam, add(qg, &wxs[0]), dl, add(dq, &wxs[1])]
         };
         let classes = cur.classes.clone();
-        let eval = |this: &mut Self, alpha: f64| -> Result<(Point, Vec<GuardRow>)> {
+        let basis = self.basis_solutions(cur);
+        // The guards at α: from the piece's basis solutions where there are some (O(J m)),
+        // else from solves with M_S. `exact`: always the latter (the point that ends the
+        // piece is computed from the data, and its d kept for the join).
+        let eval = |this: &mut Self, alpha: f64, exact: bool| -> Result<(Point, Vec<GuardRow>)> {
             let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
-            let c = this.consts();
             let qg = shift_gap(&q, this.problem.gap_equilibrated());
-            let lam = msolve(this, &c.piece_rhs(&classes, &qg));
-            let dl = msolve(this, &c.piece_rhs(&classes, &dq));
-            let mut t = dl;
+            let [lam, d, mut t, rate] = match (&basis, exact, this.load.weights_at(alpha)) {
+                (Some(bs), false, Some((w, dw))) => bs.at(w, dw, &qg, &dq),
+                _ => solve(this, &qg, &dq),
+            };
             t.push(1.0);
-            let rate = this.rate_along(&t, &dq);
-            let pt = Point { lam, alpha, q, dq };
-            let table = this.guard_table(&classes, &pt, Some((&t, &rate)));
-            Ok((pt, table))
+            let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
+            if exact {
+                this.prime_gaps(alpha, &lam, d);
+            }
+            Ok((Point { lam, alpha, q, dq }, table))
         };
-        let (mut pa, mut ga) = eval(self, cur.alpha)?;
+        let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
         let mut h = (span / 32.0).min(hmax).min((bound - cur.alpha).abs());
         let hmin = span * 1e-12;
@@ -338,7 +425,7 @@ impl Path {
             };
             let at_bound = (bound - pa.alpha).abs() <= h;
             let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
-            let (mut pb, mut gb) = eval(self, b_alpha)?;
+            let (mut pb, mut gb) = eval(self, b_alpha, false)?;
             // A guard the piece just entered (zero at a, increasing) that is negative at b:
             // the step overshoots the piece's first stretch; shorten it.
             let premature = (0..gb.len())
@@ -364,7 +451,7 @@ impl Path {
                         pb.alpha,
                         dir * ga[k].slope,
                         dir * gb[k].slope,
-                        |x| match eval(self, x) {
+                        |x| match eval(self, x, false) {
                             Ok((_, tab)) => dir * tab[k].slope,
                             Err(e) => {
                                 err = Some(e);
@@ -375,14 +462,14 @@ impl Path {
                     if let Some(e) = err {
                         return Err(e);
                     }
-                    let (_, tab) = eval(self, smin)?;
+                    let (_, tab) = eval(self, smin, false)?;
                     if tab[k].value < -tol[k] && cut.is_none_or(|c| dir * (smin - c) < 0.0) {
                         cut = Some(smin);
                     }
                 }
             }
             if let Some(smin) = cut {
-                (pb, gb) = eval(self, smin)?;
+                (pb, gb) = eval(self, smin, false)?;
             }
             let at_bound = at_bound && cut.is_none();
             let delta = pb.alpha - pa.alpha;
@@ -393,7 +480,7 @@ impl Path {
             // below zero and back inside one step) fails this test and shortens the step.
             // A guard already negative at the midpoint is a crossing inside the step.
             if h > hmin {
-                let (_, gm) = eval(self, pa.alpha + 0.5 * delta)?;
+                let (_, gm) = eval(self, pa.alpha + 0.5 * delta, false)?;
                 let untrusted = (0..gb.len()).any(|k| {
                     let (v0, v1, vm) = (ga[k].value, gb[k].value, gm[k].value);
                     let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
@@ -419,7 +506,12 @@ impl Path {
                     continue;
                 }
                 if at_bound {
-                    return Ok(Exit::Window(pb));
+                    // From the data where pb came from the basis solutions.
+                    let pt = match basis {
+                        Some(_) => eval(self, pb.alpha, true)?.0,
+                        None => pb,
+                    };
+                    return Ok(Exit::Window(pt));
                 }
                 pa = pb;
                 ga = gb;
@@ -437,7 +529,7 @@ impl Path {
                     a0
                 } else {
                     let mut err = None;
-                    let r = brent(a0, b0, fa, fb, |x| match eval(self, x) {
+                    let r = brent(a0, b0, fa, fb, |x| match eval(self, x, false) {
                         Ok((_, tab)) => tab[k].value,
                         Err(e) => {
                             err = Some(e);
@@ -454,7 +546,7 @@ impl Path {
                 }
             }
             let (root, g) = first.expect("at least one crossing");
-            let (pt, _) = eval(self, root)?;
+            let (pt, _) = eval(self, root, true)?;
             return Ok(Exit::Guards(pt, vec![g]));
         }
     }
