@@ -724,23 +724,63 @@ impl Delassus {
     /// for condensed input `f` is already `q` in the caller's rows, and only the
     /// equilibration is applied. Errors: the host's solve failed.
     pub fn condense(&self, f: &[f64]) -> Result<Vec<f64>> {
+        Ok(self.condense_many(&[f])?.pop().expect("one column"))
+    }
+
+    /// [`Self::condense`] for every vector of `fs`, in one pass over the factor for all
+    /// of them: the forward half only where W came from the factor's trailing block
+    /// ([`Self::condense_half`]). Errors as [`Self::condense`].
+    pub(crate) fn condense_many(&self, fs: &[&[f64]]) -> Result<Vec<Vec<f64>>> {
         if let Operator::Condensed { row_scale } = &self.op {
-            return Ok(f.iter().zip(row_scale).map(|(v, s)| v / s).collect());
+            return Ok(fs
+                .iter()
+                .map(|f| f.iter().zip(row_scale).map(|(v, s)| v / s).collect())
+                .collect());
         }
-        // B (h² A)⁻¹ (h f) = (B / h) A⁻¹ f
-        let mut x: Vec<f64> = f.iter().map(|v| self.h * v).collect();
-        let n = x.len();
-        self.solve_scaled(faer::MatMut::from_column_major_slice_mut(&mut x, n, 1))?;
-        let mut q = vec![0.0; self.b.nrows()];
-        self.b.mul_vec(&x, &mut q);
-        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-            return Err(Error::Numerical(format!(
-                "the condensed load q = B A^-1 f overflows (row {} is {}): the load is too large for this A",
-                i + 1,
-                q[i]
+        let n = self.n;
+        if let Some(f) = fs.iter().find(|f| f.len() != n) {
+            return Err(Error::Dimension(format!(
+                "a load vector has {} entries, A has n = {n}",
+                f.len()
             )));
         }
-        Ok(q)
+        let mut x = crate::error::try_zeros(n, fs.len(), "the condensed load vectors")?;
+        for (c, f) in fs.iter().enumerate() {
+            for (i, v) in f.iter().enumerate() {
+                x[(i, c)] = *v;
+            }
+        }
+        let qs: Vec<Vec<f64>> = if self.has_half_solve() {
+            self.half_solve(x.as_mut())?;
+            (0..fs.len())
+                .map(|c| {
+                    let y = x.col(c).try_as_col_major().expect("contiguous");
+                    self.condense_half(y.as_slice())
+                })
+                .collect()
+        } else {
+            // B (h² A)⁻¹ (h f) = (B / h) A⁻¹ f
+            x *= faer::Scale(self.h);
+            self.solve_scaled(x.as_mut())?;
+            (0..fs.len())
+                .map(|c| {
+                    let xc = x.col(c).try_as_col_major().expect("contiguous");
+                    let mut q = vec![0.0; self.b.nrows()];
+                    self.b.mul_vec(xc.as_slice(), &mut q);
+                    q
+                })
+                .collect()
+        };
+        for q in &qs {
+            if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+                return Err(Error::Numerical(format!(
+                    "the condensed load q = B A^-1 f overflows (row {} is {}): the load is too large for this A",
+                    i + 1,
+                    q[i]
+                )));
+            }
+        }
+        Ok(qs)
     }
 
     /// The displacement `u = A⁻¹ (f + (B / h)ᵀ λ)` (one back-solve; `h` as in

@@ -170,6 +170,10 @@ pub(crate) struct BoundLoad {
     dweights: Vec<f64>,
     /// α of `weights` (NaN before the first evaluation).
     weights_alpha: f64,
+    /// A general load's last `(α, q, q')`: the tracer often asks again at the same α (a
+    /// root, then the join at it), and each evaluation costs the user's callbacks and a
+    /// solve with A.
+    last_general: Option<(f64, Vec<f64>, Vec<f64>)>,
 }
 
 impl BoundLoad {
@@ -242,6 +246,7 @@ impl BoundLoad {
             weights: vec![0.0; k],
             dweights: vec![0.0; k],
             weights_alpha: f64::NAN,
+            last_general: None,
         })
     }
 
@@ -453,15 +458,19 @@ impl BoundLoad {
                 Ok((q, dq))
             }
             Load::General { n, f, df } => {
+                if let Some((a, q, dq)) = &self.last_general
+                    && *a == alpha
+                {
+                    return Ok((q.clone(), dq.clone()));
+                }
                 let n = *n;
                 let mut fv = vec![0.0; n];
                 call_vector(f, alpha, &mut fv, "f")?;
-                let q = del.condense(&fv)?;
-                let dq = match df {
+                let d = match df {
                     Some(df) => {
                         let mut d = vec![0.0; n];
                         call_vector(df, alpha, &mut d, "f'")?;
-                        del.condense(&d)?
+                        d
                     }
                     None => {
                         let h = f64::EPSILON.cbrt() * alpha.abs().max(1.0);
@@ -469,14 +478,17 @@ impl BoundLoad {
                         let mut fm = vec![0.0; n];
                         call_vector(f, alpha + h, &mut fp, "f")?;
                         call_vector(f, alpha - h, &mut fm, "f")?;
-                        let d: Vec<f64> = fp
-                            .iter()
+                        fp.iter()
                             .zip(&fm)
                             .map(|(a, b)| (a - b) / (2.0 * h))
-                            .collect();
-                        del.condense(&d)?
+                            .collect()
                     }
                 };
+                // q and q' in one pass over the factor of A.
+                let mut qs = del.condense_many(&[&fv, &d])?;
+                let dq = qs.pop().expect("two columns");
+                let q = qs.pop().expect("two columns");
+                self.last_general = Some((alpha, q.clone(), dq.clone()));
                 Ok((q, dq))
             }
         }
