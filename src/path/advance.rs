@@ -85,6 +85,41 @@ impl Path {
         Some(BasisSolutions { y, wy })
     }
 
+    /// The point `(λ, d)` of the current piece at α from the guess `lam` (the basis
+    /// solutions' combination), `qg = q(α) − (g, 0)`: d by one product with W, kept when
+    /// its residual on the piece equations from the data is at rounding level, else
+    /// corrected by a checked solve from that residual. None when the correction fails
+    /// its check (or for a piece not solved by updates).
+    fn checked_point(
+        &self,
+        cur: &CurrentPiece,
+        qg: &[f64],
+        lam: Vec<f64>,
+    ) -> Option<(Vec<f64>, Vec<f64>)> {
+        let PieceSolver::Updated(u) = &*cur.lu else {
+            return None;
+        };
+        let c = self.consts();
+        let w = self.problem.delassus().w();
+        let rb = self.row_bound();
+        let d = displacement_gaps(w, qg, &lam);
+        let zeros = vec![0.0; 2 * c.p];
+        let r = update::residual_rows(&c, &cur.classes, &lam, &d, &zeros);
+        let rhs = c.piece_rhs(&cur.classes, qg);
+        if update::relative_residual(&c, &cur.classes, &r, &lam, &rhs, rb) <= update::REFINE_ABOVE {
+            return Some((lam, d));
+        }
+        let col = update::Rhs {
+            b: &rhs,
+            guess: Some((&lam, &r)),
+        };
+        let k = u.solve_checked_many(&c, w, &[col], rb).pop()?;
+        (k.rel <= 1e-12).then(|| {
+            let d = d.iter().zip(&k.wx).map(|(a, b)| a + b).collect();
+            (k.x, d)
+        })
+    }
+
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
     /// with the rate of d along it (`W t_λ + q' t_α`, see [`Path::rate_along`]).
     pub(super) fn guard_table(
@@ -395,13 +430,23 @@ impl Path {
         let classes = cur.classes.clone();
         let basis = self.basis_solutions(cur);
         // The guards at α: from the piece's basis solutions where there are some (O(J m)),
-        // else from solves with M_S. `exact`: always the latter (the point that ends the
-        // piece is computed from the data, and its d kept for the join).
+        // else from solves with M_S. `exact`: the point that ends the piece, checked
+        // against the data (its combination kept where its residual is at rounding level,
+        // else solved for), and its d kept for the join.
         let eval = |this: &mut Self, alpha: f64, exact: bool| -> Result<(Point, Vec<GuardRow>)> {
             let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
             let qg = shift_gap(&q, this.problem.gap_equilibrated());
-            let [lam, d, mut t, rate] = match (&basis, exact, this.load.weights_at(alpha)) {
-                (Some(bs), false, Some((w, dw))) => bs.at(w, dw, &qg, &dq),
+            let [lam, d, mut t, rate] = match (&basis, this.load.weights_at(alpha)) {
+                (Some(bs), Some((w, dw))) => {
+                    let [lam, d, t, rate] = bs.at(w, dw, &qg, &dq);
+                    if !exact {
+                        [lam, d, t, rate]
+                    } else if let Some((lam, d)) = this.checked_point(cur, &qg, lam) {
+                        [lam, d, t, rate]
+                    } else {
+                        solve(this, &qg, &dq)
+                    }
+                }
                 _ => solve(this, &qg, &dq),
             };
             t.push(1.0);
