@@ -170,6 +170,10 @@ pub(crate) struct BoundLoad {
     dweights: Vec<f64>,
     /// α of `weights` (NaN before the first evaluation).
     weights_alpha: f64,
+    /// The last few `(α, w(α))` of a basis load, newest last: the term magnitudes at a
+    /// point ([`Self::term_magnitude_rows`]) must not depend on which α was evaluated
+    /// since (the tracer evaluates the entry of a piece after its exit point).
+    recent_weights: Vec<(f64, Vec<f64>)>,
     /// A general load's last `(α, q, q')`: the tracer often asks again at the same α (a
     /// root, then the join at it), and each evaluation costs the user's callbacks and a
     /// solve with A.
@@ -246,20 +250,28 @@ impl BoundLoad {
             weights: vec![0.0; k],
             dweights: vec![0.0; k],
             weights_alpha: f64::NAN,
+            recent_weights: Vec::new(),
             last_general: None,
         })
     }
 
     /// The magnitude of the terms that make up each row of `q(α)`: `Σ_j |w_j(α)| |q_j,k|`
-    /// (affine: `w = (1, α)`; basis: the weights last evaluated, if at this α). Rounding
-    /// errors in `q_k(α)` are proportional to it, not to `|q_k(α)|`, which can cancel to
-    /// zero. `None` for a general load (or basis weights not evaluated at α).
+    /// (affine: `w = (1, α)`; basis: the weights evaluated at this α, if among the last
+    /// few evaluations). Rounding errors in `q_k(α)` are proportional to it, not to
+    /// `|q_k(α)|`, which can cancel to zero. `None` for a general load (or basis weights
+    /// not evaluated at α lately).
     pub(crate) fn term_magnitude_rows(&self, alpha: f64) -> Option<Vec<f64>> {
         let w: Vec<f64> = match &self.load {
             Load::Affine { .. } => vec![1.0, alpha.abs()],
-            Load::Basis { .. } if self.weights_alpha == alpha => {
-                self.weights.iter().map(|w| w.abs()).collect()
-            }
+            Load::Basis { .. } => self
+                .recent_weights
+                .iter()
+                .rev()
+                .find(|(a, _)| *a == alpha)?
+                .1
+                .iter()
+                .map(|w| w.abs())
+                .collect(),
             _ => return None,
         };
         let m = self.q_basis.first()?.len();
@@ -334,6 +346,11 @@ impl BoundLoad {
             });
         }
         self.weights_alpha = alpha;
+        const RECENT: usize = 8;
+        if self.recent_weights.len() == RECENT {
+            self.recent_weights.remove(0);
+        }
+        self.recent_weights.push((alpha, self.weights.clone()));
         Ok(())
     }
 

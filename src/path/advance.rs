@@ -593,17 +593,64 @@ impl Path {
             let (root, g) = first.expect("at least one crossing");
             let (mut pt, tab) = eval(self, root, true)?;
             // Under a basis load the root is that of the guard combined from the basis
-            // solutions, whose rounding is not the data's: with weights that cancel 100-fold
-            // such roots were off by up to 1.5e-10 where a direct solve gives 1.7e-11 (and
-            // one path stopped at a join). One Newton step on the guard at the checked
-            // point makes it the data's root.
+            // solutions, whose rounding is not the data's: the point solved for from the
+            // data there can miss the guard's zero by more than the join's tolerance
+            // (weights that cancel 100-fold; a slender p = 2000 mesh, where the data's
+            // λ(α) is itself known to ~1e-8 only). So the root is found again on the data's
+            // guard: a Newton step from the checked point, taken where the guard is well
+            // inside the join's tolerance there, else (the data's guard noisy at that
+            // level) a bracket about it and Brent: the point that ends the piece is the
+            // data's at the data's root, as where every evaluation is solved for.
             if basis.is_some()
-                && let Some(row) = tab.iter().find(|r| r.guard == g)
+                && let Some(k) = tab.iter().position(|r| r.guard == g)
             {
-                let next = root - row.value / row.slope;
-                if next.is_finite() && next != root && (next - pa.alpha) * (next - pb.alpha) <= 0.0
-                {
-                    pt = eval(self, next, true)?.0;
+                let (lo_a, hi_a) = (pa.alpha.min(pb.alpha), pa.alpha.max(pb.alpha));
+                let (mut x0, mut v0) = (root, tab[k].value);
+                let slope = tab[k].slope;
+                let mut bracket = None;
+                let mut step = -v0 / slope;
+                for _ in 0..8 {
+                    if v0 == 0.0 || !step.is_finite() || step == 0.0 {
+                        break;
+                    }
+                    let x1 = (x0 + step).clamp(lo_a, hi_a);
+                    if x1 == x0 {
+                        break;
+                    }
+                    let (p1, t1) = eval(self, x1, true)?;
+                    let v1 = t1[k].value;
+                    // Well inside the join's tolerance for the guard: taken as it is.
+                    let accept = 0.25 * self.tol_at(&p1).of(&self.consts().guard_form(g));
+                    if v1.abs() <= accept {
+                        pt = p1;
+                        break;
+                    }
+                    if (v1 > 0.0) != (v0 > 0.0) || v1 == 0.0 {
+                        bracket = Some((x0, v0, x1, v1, p1));
+                        break;
+                    }
+                    if v1.abs() < v0.abs() {
+                        (x0, v0, pt) = (x1, v1, p1);
+                    }
+                    step *= 2.0;
+                }
+                if let Some((xa, va, xb, vb, pb1)) = bracket {
+                    let mut err = None;
+                    let r = if vb == 0.0 {
+                        xb
+                    } else {
+                        brent(xa, xb, va, vb, |x| match eval(self, x, true) {
+                            Ok((_, tab)) => tab[k].value,
+                            Err(e) => {
+                                err = Some(e);
+                                f64::NAN
+                            }
+                        })
+                    };
+                    if let Some(e) = err {
+                        return Err(e);
+                    }
+                    pt = if r == xb { pb1 } else { eval(self, r, true)?.0 };
                 }
             }
             return Ok(Exit::Guards(pt, vec![g]));
