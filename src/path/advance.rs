@@ -608,6 +608,7 @@ impl Path {
                 let (mut x0, mut v0) = (root, tab[k].value);
                 let slope = tab[k].slope;
                 let mut bracket = None;
+                let mut accept = f64::NAN;
                 let mut step = -v0 / slope;
                 for _ in 0..8 {
                     if v0 == 0.0 || !step.is_finite() || step == 0.0 {
@@ -620,7 +621,7 @@ impl Path {
                     let (p1, t1) = eval(self, x1, true)?;
                     let v1 = t1[k].value;
                     // Well inside the join's tolerance for the guard: taken as it is.
-                    let accept = 0.25 * self.tol_at(&p1).of(&self.consts().guard_form(g));
+                    accept = 0.25 * self.tol_at(&p1).of(&self.consts().guard_form(g));
                     if v1.abs() <= accept {
                         pt = p1;
                         break;
@@ -639,7 +640,9 @@ impl Path {
                     let r = if vb == 0.0 {
                         xb
                     } else {
+                        // Brent stops at a value within `accept` (reported as a zero).
                         brent(xa, xb, va, vb, |x| match eval(self, x, true) {
+                            Ok((_, tab)) if tab[k].value.abs() <= accept => 0.0,
                             Ok((_, tab)) => tab[k].value,
                             Err(e) => {
                                 err = Some(e);
