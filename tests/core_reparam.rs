@@ -227,7 +227,8 @@ fn a_basis_whose_weights_cancel() {
         let (nx, ny) = (3 + (s % 20) as usize, 1 + ((s / 3) % 3) as usize);
         common::fe_case(s, nx, ny, [0.3, 1.0, 3.0, 5.0][(s % 4) as usize])
     }));
-    for (eps, tol) in [(1e-2, 1e-10), (1e-4, 2e-8)] {
+    // About five times the measured worst (rounding differs between machines).
+    for (eps, tol) in [(1e-2, 3e-10), (1e-4, 5e-8)] {
         for fresh in [false, true] {
             let mut worst = 0f64;
             let mut events = 0;
