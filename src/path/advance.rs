@@ -2,7 +2,7 @@
 //! ([`Path::exit_linear`]) and the certified steps of a nonlinear load
 //! ([`Path::exit_graph`]), both on the table of guard values and derivatives.
 
-use super::roots::{brent, hermite_min};
+use super::roots::{brent_fallible, hermite_min};
 use super::*;
 use crate::dense::axpy;
 
@@ -490,23 +490,13 @@ impl Path {
                     && dir * ga[k].slope < 0.0
                     && dir * gb[k].slope > 0.0
                 {
-                    let mut err = None;
-                    let smin = brent(
+                    let smin = brent_fallible(
                         pa.alpha,
                         pb.alpha,
                         dir * ga[k].slope,
                         dir * gb[k].slope,
-                        |x| match eval(self, x, false) {
-                            Ok((_, tab)) => dir * tab[k].slope,
-                            Err(e) => {
-                                err = Some(e);
-                                f64::NAN
-                            }
-                        },
-                    );
-                    if let Some(e) = err {
-                        return Err(e);
-                    }
+                        |x| Ok(dir * eval(self, x, false)?.1[k].slope),
+                    )?;
                     let (_, tab) = eval(self, smin, false)?;
                     if tab[k].value < -tol[k] && cut.is_none_or(|c| dir * (smin - c) < 0.0) {
                         cut = Some(smin);
@@ -573,18 +563,7 @@ impl Path {
                 let root = if fa <= 0.0 {
                     a0
                 } else {
-                    let mut err = None;
-                    let r = brent(a0, b0, fa, fb, |x| match eval(self, x, false) {
-                        Ok((_, tab)) => tab[k].value,
-                        Err(e) => {
-                            err = Some(e);
-                            f64::NAN
-                        }
-                    });
-                    if let Some(e) = err {
-                        return Err(e);
-                    }
-                    r
+                    brent_fallible(a0, b0, fa, fb, |x| Ok(eval(self, x, false)?.1[k].value))?
                 };
                 if first.is_none_or(|f| dir * (root - f.0) < 0.0) {
                     first = Some((root, g));
@@ -636,23 +615,15 @@ impl Path {
                     step *= 2.0;
                 }
                 if let Some((xa, va, xb, vb, pb1)) = bracket {
-                    let mut err = None;
                     let r = if vb == 0.0 {
                         xb
                     } else {
                         // Brent stops at a value within `accept` (reported as a zero).
-                        brent(xa, xb, va, vb, |x| match eval(self, x, true) {
-                            Ok((_, tab)) if tab[k].value.abs() <= accept => 0.0,
-                            Ok((_, tab)) => tab[k].value,
-                            Err(e) => {
-                                err = Some(e);
-                                f64::NAN
-                            }
-                        })
+                        brent_fallible(xa, xb, va, vb, |x| {
+                            let v = eval(self, x, true)?.1[k].value;
+                            Ok(if v.abs() <= accept { 0.0 } else { v })
+                        })?
                     };
-                    if let Some(e) = err {
-                        return Err(e);
-                    }
                     pt = if r == xb { pb1 } else { eval(self, r, true)?.0 };
                 }
             }

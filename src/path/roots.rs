@@ -111,6 +111,28 @@ pub(super) fn brent(a: f64, b: f64, fa: f64, fb: f64, mut f: impl FnMut(f64) -> 
     b
 }
 
+/// [`brent`] on a fallible `f`: the first error ends the search and is returned.
+pub(super) fn brent_fallible<E>(
+    a: f64,
+    b: f64,
+    fa: f64,
+    fb: f64,
+    mut f: impl FnMut(f64) -> Result<f64, E>,
+) -> Result<f64, E> {
+    let mut err = None;
+    let r = brent(a, b, fa, fb, |x| match f(x) {
+        Ok(v) => v,
+        Err(e) => {
+            err = Some(e);
+            f64::NAN
+        }
+    });
+    match err {
+        Some(e) => Err(e),
+        None => Ok(r),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
