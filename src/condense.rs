@@ -731,6 +731,9 @@ impl Delassus {
     /// of them: the forward half only where W came from the factor's trailing block
     /// ([`Self::condense_half`]). Errors as [`Self::condense`].
     pub(crate) fn condense_many(&self, fs: &[&[f64]]) -> Result<Vec<Vec<f64>>> {
+        if fs.is_empty() {
+            return Ok(Vec::new());
+        }
         if let Operator::Condensed { row_scale } = &self.op {
             return Ok(fs
                 .iter()

@@ -219,11 +219,8 @@ impl BoundLoad {
                 .collect();
             (q, Some(y))
         } else {
-            let q = vectors
-                .iter()
-                .map(|v| del.condense(v))
-                .collect::<Result<_>>()?;
-            (q, None)
+            let f: Vec<&[f64]> = vectors.iter().map(|v| v.as_slice()).collect();
+            (del.condense_many(&f)?, None)
         };
         let mut q_lo = if vectors.is_empty() {
             None
