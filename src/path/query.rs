@@ -217,7 +217,7 @@ impl Path {
     /// (several past a fold), each by interpolation between the piece's end points for an
     /// affine load (exact: a piece is then a segment), or one solve with the piece matrix
     /// otherwise (O(k m²) by an update of the path's current factorisation when the piece
-    /// differs from it in k ≤ m/8 nodes, checked against the data; O(m³) by a fresh LU
+    /// differs from it in k ≤ m/16 nodes, checked against the data; O(m³) by a fresh LU
     /// beyond that), plus one back-solve for u. Points shared by two pieces (transition
     /// points) are reported once. Empty if the traced path never reached `alpha`. Errors: not started, load
     /// failure.

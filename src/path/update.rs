@@ -34,11 +34,16 @@ use crate::class::Class;
 use crate::dense::{axpy, dot};
 use crate::piece::{DenseLu, PieceConstants};
 
-/// Most updates kept on one base before a refactorisation: m/8 (at least 8). The
-/// border of C then costs O(m²) per update, like a solve, and a refactorisation
-/// (O(m³)) is paid once per ~m/8 transitions.
+/// Most updates kept on one base before a refactorisation: m/16 (at least 8). With k
+/// updates a transition pays O(k m) for the border of C and the capacitance corrections,
+/// besides its O(m²) solves, and a refactorisation (O(m³)) is paid once per K updates,
+/// so the cost per transition is about R/K + c K/2, least at K = √(2R/c) ∝ m. Measured
+/// on this project's machine: K ≈ m/12 at m = 960 and m/17 at m = 4000 (where the
+/// updates' columns no longer stay in cache); the total is flat near the least, and m/16
+/// also keeps the SMW sums short, so fewer solves need refining (half as many at
+/// m = 4000 as with m/8).
 pub(crate) fn max_updates(m: usize) -> usize {
-    (m / 8).max(8)
+    (m / 16).max(8)
 }
 
 /// A factorised base piece matrix, shared by every update derived from it.
