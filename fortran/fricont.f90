@@ -823,9 +823,10 @@ contains
         call handle(c_problem_set_r(self%h, r), err, 'fricont_problem%set_r')
     end subroutine problem_set_r
 
-    !> Threads of the set-up (factorisation of A and forming W), 1..1024; default 1 (no
-    !> thread is started). Results agree with one thread to rounding; tracing runs on the
-    !> calling thread. FRICONT_ERR_RANGE outside 1..1024.
+    !> Threads of the set-up (factorisation of A and forming W) and, where 2p >= 2048, of
+    !> the trace's dense passes (a private pool per call into a path; callbacks stay on
+    !> the calling thread), 1..1024; default 1 (no thread is started). Results agree with
+    !> one thread to rounding. FRICONT_ERR_RANGE outside 1..1024.
     subroutine problem_set_threads(self, threads, err)
         class(fricont_problem), intent(inout) :: self
         integer, intent(in) :: threads

@@ -371,8 +371,10 @@ public:
     }
     /// The augmentation parameter r > 0 (does not change solutions).
     void set_r(double r) { check(fricont_problem_set_r(h_, r)); }
-    /// Threads of the set-up (factorisation of A, forming W), 1..=1024; default 1 (no
-    /// thread started). Results agree with one thread to rounding. Throws on a bad count.
+    /// Threads of the set-up (factorisation of A, forming W) and, where 2p ≥ 2048, of the
+    /// trace's dense passes (a private pool per call into a path), 1..=1024; default 1
+    /// (no thread started). Results agree with one thread to rounding. Throws on a bad
+    /// count.
     void set_threads(int64_t threads) { check(fricont_problem_set_threads(h_, threads)); }
     /// Validates and factorises now (optional).
     void build() { check(fricont_problem_build(h_)); }

@@ -59,6 +59,7 @@ pub mod solve;
 
 pub use class::Class;
 pub use condense::{HostSolve, SolveFailure, SolveFn};
+pub use dense::PARALLEL_MIN_ORDER;
 pub use error::{Error, Result};
 /// The faer version fricont is built with (W of [`ProblemBuilder::condensed`] and the
 /// blocks of a [`HostSolve`] are faer matrices).

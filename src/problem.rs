@@ -494,12 +494,17 @@ impl ProblemBuilder {
     }
 
     /// The number of threads of the set-up (the numeric Cholesky factorisation of A and
-    /// forming W), 1 ..= [`MAX_THREADS`]; default 1. With more than one, the build runs
-    /// faer's parallel kernels inside a private rayon pool of that many threads, started
-    /// for the build and stopped after it: fricont never uses a global pool, and starts
-    /// no thread at all with 1. Results agree with the single-threaded ones to rounding
-    /// (1e-14 relative). Tracing always runs on the calling thread. Without the crate's
-    /// `threads` feature the option is accepted and ignored.
+    /// forming W) and of the tracer's dense passes, 1 ..= [`MAX_THREADS`]; default 1.
+    /// With more than one, the build runs faer's parallel kernels inside a private rayon
+    /// pool of that many threads, started for the build and stopped after it; and where
+    /// m = 2p ≥ [`crate::PARALLEL_MIN_ORDER`] (2048), each call into a path
+    /// (start, step, run, `solutions_at`, `choose_branch`) starts such a pool for its
+    /// LU factorisations, triangular solves and products with W, and stops it before
+    /// returning. The path's own logic and every callback (load, host's solve, monitor)
+    /// stay on the calling thread. fricont never uses a global pool, and starts no thread
+    /// at all with 1. Results agree with the single-threaded ones to rounding (1e-14
+    /// relative for W; events to 1e-12). Without the crate's `threads` feature the option
+    /// is accepted and ignored.
     pub fn threads(mut self, threads: usize) -> Self {
         self.threads = threads;
         self
@@ -738,6 +743,7 @@ impl ProblemBuilder {
             w_row_sums,
             delassus,
             extended,
+            threads: self.threads,
         })
     }
 }
@@ -1154,6 +1160,8 @@ pub struct Problem {
     delassus: std::sync::Arc<Delassus>,
     /// See [`Problem::extended_precision`].
     extended: bool,
+    /// See [`Problem::threads`].
+    threads: usize,
 }
 
 impl Problem {
@@ -1240,6 +1248,12 @@ impl Problem {
     pub fn delassus(&self) -> &Delassus {
         &self.delassus
     }
+    /// The threads it was built with ([`ProblemBuilder::threads`], 1 by default): those of
+    /// the set-up, and of the tracer's dense passes where m = 2p ≥
+    /// [`crate::PARALLEL_MIN_ORDER`].
+    pub fn threads(&self) -> usize {
+        self.threads
+    }
     /// True when W is carried beyond double precision (see [`ExtendedPrecision`]): W was
     /// refined (`W_hi + W_lo`, [`Delassus::w_lo`]; the loads' condensed vectors are then
     /// refined too), or the problem was made from condensed data with
@@ -1274,6 +1288,7 @@ impl Problem {
             w_row_sums: self.w_row_sums.clone(),
             delassus: self.delassus.clone(),
             extended: self.extended,
+            threads: self.threads,
         })
     }
 }

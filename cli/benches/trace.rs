@@ -5,7 +5,11 @@
 //! cargo bench --bench trace -- DIR          # another problem directory
 //! FRICONT_BENCH_CASE=DIR FRICONT_BENCH_REPS=15 cargo bench --bench trace
 //! FRICONT_BENCH_LOAD=basis-sine cargo bench --bench trace -- DIR
+//! FRICONT_BENCH_THREADS=2 cargo bench --bench trace -- DIR
 //! ```
+//!
+//! `FRICONT_BENCH_THREADS` (default 1) is the problem's `threads`: the set-up's, and the
+//! trace's dense passes where 2p ≥ `fricont::PARALLEL_MIN_ORDER`.
 //!
 //! `FRICONT_BENCH_LOAD` chooses the load: `affine` (default: the directory's f0 + α f1),
 //! or the oscillating `f0 + φ(α) f1`, `φ(α) = α + A sin(2π·10 (α − α_start)/L)` with
@@ -103,13 +107,17 @@ fn main() {
         }
     };
 
+    let threads: usize = std::env::var("FRICONT_BENCH_THREADS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
     let mut setup = Vec::with_capacity(reps);
     let mut trace = Vec::with_capacity(reps);
     let mut start = Vec::with_capacity(reps);
     let mut summary = String::new();
     for _ in 0..reps {
         let t = Instant::now();
-        let problem = Arc::new(case.problem(None).expect("problem"));
+        let problem = Arc::new(case.builder().threads(threads).build().expect("problem"));
         let path = Path::new(Arc::clone(&problem), load(), opts.clone()).expect("path");
         setup.push(t.elapsed().as_secs_f64());
         drop(path);
@@ -133,7 +141,7 @@ fn main() {
     let (t_med, t_min) = median_min(&mut trace);
     let (st_med, st_min) = median_min(&mut start);
     println!(
-        "case {} (n = {}, p = {}), load {kind}, {reps} repetitions; {summary}",
+        "case {} (n = {}, p = {}), load {kind}, {threads} thread(s), {reps} repetitions; {summary}",
         dir.display(),
         case.n(),
         case.p()

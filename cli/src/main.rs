@@ -124,8 +124,9 @@ struct TraceArgs {
     /// Stop after this many transition points (at least 1; default 10000).
     #[arg(long)]
     max_steps: Option<usize>,
-    /// Threads of the set-up (factorisation of A, forming W), 1..=1024. Results agree
-    /// with one thread to rounding; tracing runs on one thread.
+    /// Threads of the set-up (factorisation of A, forming W) and, where 2p ≥ 2048, of the
+    /// trace's dense passes (LU factorisations, solves, products with W), 1..=1024.
+    /// Results agree with one thread to rounding.
     #[arg(long, default_value_t = 1)]
     threads: usize,
     /// Carry W and the condensed loads beyond double precision (mixed-precision

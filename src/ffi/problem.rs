@@ -827,13 +827,24 @@ pub unsafe extern "C" fn fricont_problem_set_r(
     })
 }
 
-/// Sets the number of threads of the set-up: the numeric Cholesky factorisation of A and
-/// forming W run on a private pool of `threads` threads, started by the build and
-/// stopped when it ends. Default 1: no thread is ever started, and fricont never uses a
-/// global thread pool of the host. Results agree with one thread to rounding (1e-14
-/// relative); tracing always runs on the calling thread. Takes effect at the next build
-/// (an already built problem is kept as it is). A library built without its `threads`
-/// feature accepts the setting and runs on the calling thread.
+/// The order m = 2p from which a path's dense passes (LU factorisations, triangular
+/// solves, products with W) use the problem's threads (`fricont_problem_set_threads`);
+/// below it they run on the calling thread, as fast.
+pub const FRICONT_PARALLEL_MIN_ORDER: i64 = 2048;
+const _: () = assert!(FRICONT_PARALLEL_MIN_ORDER as usize == crate::dense::PARALLEL_MIN_ORDER);
+
+/// Sets the number of threads of the set-up and of the trace's dense passes. The numeric
+/// Cholesky factorisation of A and forming W run on a private pool of `threads` threads,
+/// started by the build and stopped when it ends. Where m = 2p ≥ 2048
+/// (`FRICONT_PARALLEL_MIN_ORDER`: below it one thread is as fast), each call into a path
+/// of the problem (`fricont_path_start`, `_step`, `_run`, `_solutions_at`,
+/// `_choose_branch`) starts such a pool for its LU factorisations, triangular solves and
+/// products with W, and stops it before returning; the path's logic and every callback
+/// (load, host's solve, monitor) stay on the calling thread. Default 1: no thread is ever
+/// started, and fricont never uses a global thread pool of the host. Results agree with
+/// one thread to rounding (1e-14 relative in W, 1e-12 in the events' α). Takes effect at
+/// the next build (an already built problem is kept as it is). A library built without
+/// its `threads` feature accepts the setting and runs on the calling thread.
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (threads
 /// outside 1..=1024), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.

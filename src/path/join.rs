@@ -526,6 +526,7 @@ impl Path {
     /// (the path then starts again at the same point on branch `k`). Errors: not started,
     /// no bifurcation pending, `k` out of range.
     pub fn choose_branch(&mut self, k: usize) -> Result<()> {
+        let _pool = self.pool_scope();
         let tr = self
             .trace
             .as_mut()

@@ -662,6 +662,11 @@ impl Path {
         (self.opts.alpha_end - self.opts.alpha_start).abs()
     }
 
+    /// The private pool of this call's dense passes (see [`crate::ProblemBuilder::threads`]).
+    fn pool_scope(&self) -> crate::dense::TracePoolScope {
+        crate::dense::TracePoolScope::enter(self.problem.threads(), 2 * self.problem.p())
+    }
+
     fn consts(&self) -> PieceConstants<'_> {
         PieceConstants::of(&self.problem)
     }
@@ -1135,6 +1140,7 @@ impl Path {
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails, the load fails, no piece leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
+        let _pool = self.pool_scope();
         self.trace = None;
         // A path's numbers depend on its own history only: no factorisation from an
         // earlier start is reused.
@@ -1310,6 +1316,7 @@ impl Path {
     /// ends with [`EndReason::Failed`] and keeps what it traced), numerical failure
     /// (likewise).
     pub fn step(&mut self) -> Result<StepOutcome> {
+        let _pool = self.pool_scope();
         let tr = self.trace_ref()?;
         match &tr.end {
             Some(EndReason::Stopped) => self.trace.as_mut().expect("started").end = None,
@@ -1416,6 +1423,7 @@ impl Path {
         &mut self,
         mut monitor: impl FnMut(&Path, &Progress) -> std::ops::ControlFlow<()>,
     ) -> Result<EndReason> {
+        let _pool = self.pool_scope();
         loop {
             match self.step()? {
                 StepOutcome::End(r) => return Ok(r),

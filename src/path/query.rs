@@ -222,6 +222,7 @@ impl Path {
     /// points) are reported once. Empty if the traced path never reached `alpha`. Errors: not started, load
     /// failure.
     pub fn solutions_at(&mut self, alpha: f64) -> Result<Vec<Solution>> {
+        let _pool = self.pool_scope();
         let pieces = self.trace_ref()?.pieces.clone();
         let m = 2 * self.problem.p();
         // Matching α with a piece's ends: relative to α and to the piece's own extent,
