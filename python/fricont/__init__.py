@@ -280,15 +280,20 @@ class Problem:
     r : float or None: augmentation parameter (force per length), default 2p / trace(W).
     storage : "full" (symmetry checked to 1e-10 relative), "lower" or "upper" (only that
         triangle of A is read).
+    threads : int, 1 to 1024 (default 1: no thread is started): the threads of the
+        set-up and, where 2p >= 2048, of the trace's dense passes (LU factorisations,
+        solves, products with W), each on a private pool stopped when the call ends. The
+        load and monitor callables still run on the calling thread. Results agree with
+        one thread's to rounding.
 
     Duplicate entries (a COO matrix, or a CSR matrix without canonical format) are summed,
     as by every fricont interface (C, C++, Fortran, the CLI's Matrix Market files).
 
-    Raises ValueError (invalid data: dimensions, NaN/Inf, not symmetric, F < 0, r <= 0)
-    and NotPositiveDefinite (A not SPD, with the failing pivot; B rank-deficient).
+    Raises ValueError (invalid data: dimensions, NaN/Inf, not symmetric, F < 0, r <= 0,
+    threads outside 1..1024) and NotPositiveDefinite (A not SPD, with the failing pivot; B rank-deficient).
     """
 
-    def __init__(self, A, N, T, friction=0.3, gap=None, r=None, storage="full"):
+    def __init__(self, A, N, T, friction=0.3, gap=None, r=None, storage="full", threads=1):
         a = _csr("A", A)
         n = _csr("N", N)
         t = _csr("T", T)
@@ -302,7 +307,11 @@ class Problem:
                 raise ValueError(f"friction has {len(fr_list)} values, expected 1 or p = {p}")
         g = None if gap is None else [float(x) for x in np.asarray(gap, dtype=np.float64).ravel()]
         try:
-            self._core = _core.Problem(a, n, t, fr_list, g, None if r is None else float(r), storage)
+            if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+                raise ValueError(f"threads = {threads!r}: expected an integer in 1..1024")
+            self._core = _core.Problem(
+                a, n, t, fr_list, g, None if r is None else float(r), storage, int(threads)
+            )
         except Exception as err:  # noqa: BLE001
             raise _reraise(err) from None
 

@@ -74,6 +74,7 @@ class Problem:
         gap: Optional[npt.ArrayLike] = None,
         r: Optional[float] = None,
         storage: str = "full",
+        threads: int = 1,
     ) -> None: ...
     @property
     def n(self) -> int: ...

@@ -135,11 +135,13 @@ type CsrArgs<'py> = (
 #[pymethods]
 impl Problem {
     /// Builds the problem (validation, Cholesky of A, Delassus operator) with the GIL
-    /// released. `storage`: "full", "lower" or "upper". Errors: ValueError for invalid
-    /// data, NotPositiveDefinite when A is not SPD or B is rank-deficient.
+    /// released. `storage`: "full", "lower" or "upper". `threads`: those of the set-up
+    /// and, where 2p ≥ 2048, of the trace's dense passes (private pools, see
+    /// `ProblemBuilder::threads`). Errors: ValueError for invalid data or threads outside
+    /// 1..=1024, NotPositiveDefinite when A is not SPD or B is rank-deficient.
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (a, n, t, friction, gap, r, storage))]
+    #[pyo3(signature = (a, n, t, friction, gap, r, storage, threads))]
     fn new(
         py: Python<'_>,
         a: CsrArgs<'_>,
@@ -149,6 +151,7 @@ impl Problem {
         gap: Option<Vec<f64>>,
         r: Option<f64>,
         storage: &str,
+        threads: usize,
     ) -> PyResult<Self> {
         let storage = match storage {
             "full" => Storage::Full,
@@ -163,7 +166,7 @@ impl Problem {
         let a = csr("A", a.0, a.1, a.2, a.3)?;
         let nm = csr("N", n.0, n.1, n.2, n.3)?;
         let tm = csr("T", t.0, t.1, t.2, t.3)?;
-        let mut b = ProblemBuilder::new(a, storage, nm, tm);
+        let mut b = ProblemBuilder::new(a, storage, nm, tm).threads(threads);
         b = if friction.len() == 1 {
             b.friction_uniform(friction[0])
         } else {

@@ -261,6 +261,14 @@ def test_two_threads_trace_at_once_with_the_results_of_one(sample):
             (e.alpha, e.node, e.to_class) for e in ref.events]
 
 
+def test_the_threads_option_gives_the_events_of_one_thread(sample):
+    # The set-up on a private pool of 2 threads (the sample's 2p = 60 is below the order
+    # from which the trace's passes use them): W, and so the events, to rounding.
+    ref = trace_sample(sample)
+    two = trace_sample(sample, threads=2)
+    assert same_path(two, ref, rel=1e-12)
+
+
 def test_bad_inputs_raise_the_documented_exceptions(sample):
     A, N, T = sample["A"], sample["N"], sample["T"]
     with pytest.raises(ValueError, match="symmetric"):
@@ -279,6 +287,9 @@ def test_bad_inputs_raise_the_documented_exceptions(sample):
         fricont.Problem(A, N, T, friction=-1.0)
     with pytest.raises(ValueError, match="storage"):
         fricont.Problem(A, N, T, storage="both")
+    for threads in (0, 1025, 1.5, True):
+        with pytest.raises(ValueError, match="threads"):
+            fricont.Problem(A, N, T, threads=threads)
     prob = fricont.Problem(A, N, T)
     with pytest.raises(ValueError):
         prob.trace(sample["f0"][:-1], sample["f1"], window=(0, 1))
