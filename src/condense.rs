@@ -1035,9 +1035,9 @@ impl Delassus {
 
     /// The low parts of condensed load vectors: for each load vector `f_j` (n entries, the
     /// caller's units) and its condensed image `q_j` as fricont stores it (2p entries),
-    /// `exact((B / h) A⁻¹ f_j) − q_j` rounded to double, by the refinement of
-    /// [`Self::refine_w`] (a few solves per vector). None when W was not refined
-    /// ([`Self::w_lo`] is None): then q is used as stored.
+    /// `exact((B / h) A⁻¹ f_j) − q_j` rounded to double, by the refinement that gave W's
+    /// low part (mixed-precision solves with the factor of A, a few per vector). None when
+    /// W was not refined ([`Self::w_lo`] is None): then q is used as stored.
     /// Errors: lengths that do not match; out of memory.
     pub fn condense_lo(&self, f: &[&[f64]], q: &[&[f64]]) -> Result<Option<Vec<Vec<f64>>>> {
         let Some(a_full) = self.a_full.as_ref() else {
