@@ -5,6 +5,7 @@
 //! cargo bench --bench strips -- 240 480       # chosen sizes
 //! FRICONT_BENCH_FRESH=480 cargo bench --bench strips   # also fresh factorisations up to p = 480
 //! FRICONT_BENCH_EXTENDED=on cargo bench --bench strips -- 1920   # extended precision on|off (default auto)
+//! FRICONT_BENCH_THREADS=2 cargo bench --bench strips -- 1920       # the problem's threads (default 1)
 //! ```
 //!
 //! Each strip is the rectangle generator's press-shear case with `p + 1 × 4` nodes on
@@ -58,9 +59,14 @@ fn trace(case: &CaseData, fresh: bool) -> (usize, String, f64, f64, f64, usize, 
         Ok("off") => ExtendedPrecision::Off,
         _ => ExtendedPrecision::Auto,
     };
+    let threads: usize = std::env::var("FRICONT_BENCH_THREADS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1);
     let problem = Arc::new(
         case.builder()
             .extended_precision(mode)
+            .threads(threads)
             .build()
             .expect("problem"),
     );
