@@ -220,6 +220,10 @@ pub struct Delassus {
     cond: f64,
 }
 
+/// Condensed load vectors and, where they came from half solves, the half-solved
+/// vectors (see [`Delassus::condense_many_keep_half`]).
+pub(crate) type CondensedWithHalf = (Vec<Vec<f64>>, Option<Mat<f64>>);
+
 impl Delassus {
     /// Factorises `A` given by its lower triangle (CSR, row ≥ col; as CSC this is the upper
     /// triangle of the symmetric matrix) and forms `W` for `B` (2p×n).
@@ -731,14 +735,22 @@ impl Delassus {
     /// of them: the forward half only where W came from the factor's trailing block
     /// ([`Self::condense_half`]). Errors as [`Self::condense`].
     pub(crate) fn condense_many(&self, fs: &[&[f64]]) -> Result<Vec<Vec<f64>>> {
+        Ok(self.condense_many_keep_half(fs)?.0)
+    }
+
+    /// [`Self::condense_many`], also returning the half-solved vectors
+    /// `Y = L⁻¹ Pᵀ (h F)` (n × k, see [`Self::half_solve`]) where they were the way to q
+    /// ([`Self::has_half_solve`]), for the displacements at later forces.
+    pub(crate) fn condense_many_keep_half(&self, fs: &[&[f64]]) -> Result<CondensedWithHalf> {
         if fs.is_empty() {
-            return Ok(Vec::new());
+            return Ok((Vec::new(), None));
         }
         if let Operator::Condensed { row_scale } = &self.op {
-            return Ok(fs
+            let qs = fs
                 .iter()
                 .map(|f| f.iter().zip(row_scale).map(|(v, s)| v / s).collect())
-                .collect());
+                .collect();
+            return Ok((qs, None));
         }
         let n = self.n;
         if let Some(f) = fs.iter().find(|f| f.len() != n) {
@@ -753,7 +765,8 @@ impl Delassus {
                 x[(i, c)] = *v;
             }
         }
-        let qs: Vec<Vec<f64>> = if self.has_half_solve() {
+        let half = self.has_half_solve();
+        let qs: Vec<Vec<f64>> = if half {
             self.half_solve(x.as_mut())?;
             (0..fs.len())
                 .map(|c| {
@@ -783,7 +796,7 @@ impl Delassus {
                 )));
             }
         }
-        Ok(qs)
+        Ok((qs, half.then_some(x)))
     }
 
     /// The displacement `u = A⁻¹ (f + (B / h)ᵀ λ)` (one back-solve; `h` as in

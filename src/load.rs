@@ -203,29 +203,11 @@ impl BoundLoad {
         } else {
             0
         };
-        let (q_basis, half): (Vec<Vec<f64>>, _) = if del.has_half_solve() && !vectors.is_empty() {
-            let n = del.n();
-            let mut y = crate::error::try_zeros(n, vectors.len(), "the half-solved load vectors")?;
-            for (c, v) in vectors.iter().enumerate() {
-                for (i, x) in v.iter().enumerate() {
-                    y[(i, c)] = *x;
-                }
-            }
-            del.half_solve(y.as_mut())?;
-            let q = (0..y.ncols())
-                .map(|c| {
-                    del.condense_half(y.col(c).try_as_col_major().expect("contiguous").as_slice())
-                })
-                .collect();
-            (q, Some(y))
-        } else {
-            let f: Vec<&[f64]> = vectors.iter().map(|v| v.as_slice()).collect();
-            (del.condense_many(&f)?, None)
-        };
+        let f: Vec<&[f64]> = vectors.iter().map(|v| v.as_slice()).collect();
+        let (q_basis, half) = del.condense_many_keep_half(&f)?;
         let mut q_lo = if vectors.is_empty() {
             None
         } else {
-            let f: Vec<&[f64]> = vectors.iter().map(|v| v.as_slice()).collect();
             let q: Vec<&[f64]> = q_basis.iter().map(|v| v.as_slice()).collect();
             del.condense_lo(&f, &q)?
         };
