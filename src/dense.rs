@@ -28,14 +28,8 @@ pub const PARALLEL_MIN_ORDER: usize = 2048;
 #[cfg(feature = "threads")]
 thread_local! {
     /// The pool of the tracer's current call on this thread (see [`TracePoolScope`]).
-    static TRACE_POOL: std::cell::RefCell<Option<std::rc::Rc<TracePool>>> =
+    static TRACE_POOL: std::cell::RefCell<Option<std::rc::Rc<rayon::ThreadPool>>> =
         const { std::cell::RefCell::new(None) };
-}
-
-#[cfg(feature = "threads")]
-struct TracePool {
-    pool: rayon::ThreadPool,
-    threads: usize,
 }
 
 /// A private pool of threads for the dense passes of order ≥ [`PARALLEL_MIN_ORDER`] made
@@ -62,11 +56,7 @@ impl TracePoolScope {
                     .num_threads(threads)
                     .thread_name(|i| format!("fricont-{i}"))
                     .build()
-                    .map(|pool| {
-                        TRACE_POOL.with(|p| {
-                            *p.borrow_mut() = Some(std::rc::Rc::new(TracePool { pool, threads }))
-                        })
-                    })
+                    .map(|pool| TRACE_POOL.with(|p| *p.borrow_mut() = Some(std::rc::Rc::new(pool))))
                     .is_ok();
             Self { owner }
         }
@@ -94,8 +84,8 @@ fn par_kernel<T: Send>(m: usize, f: impl FnOnce(Par) -> T + Send) -> T {
     if m >= PARALLEL_MIN_ORDER
         && let Some(p) = TRACE_POOL.with(|p| p.borrow().clone())
     {
-        let threads = p.threads;
-        return p.pool.install(move || f(Par::rayon(threads)));
+        let threads = p.current_num_threads();
+        return p.install(move || f(Par::rayon(threads)));
     }
     #[cfg(not(feature = "threads"))]
     let _ = m;
