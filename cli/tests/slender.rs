@@ -351,6 +351,94 @@ fn strip_p240() {
     );
 }
 
+/// Basis loads on the p = 240 strip, against the reference by reparametrisation: the
+/// load `f0 + φ(α) f1` with φ increasing is the affine load at `s = φ(α)`, so its events
+/// are the reference's at `s_k = φ(α_k)`, with the same nodes and classes. φ is the
+/// identity (the affine load written as a basis), then an oscillation of ten periods over
+/// the window, `φ(α) = α + A sin(ω (α − α_start))` with A = 1/100 of the window and
+/// A ω = 0.63. With extended precision (auto) each piece's basis solutions are refined in
+/// double-double, and the roots are found in double on their combinations: measured
+/// 1.3e-10 for both, checked to 5e-10 (with the basis solutions in double, 1.0e-8). In
+/// double alone (W not refined either, so the data are off by more): 9.8e-8, checked to
+/// 5e-7. Both loads stopped before: the identity at α = 0.474 (0.333 in double; no
+/// neighbouring piece continued the path: each trial point of the exit's root was
+/// corrected from the data on its own, by up to cond · its residual), the oscillation at
+/// its first transitions (the new piece's own point put the guard it was entered
+/// through below its threshold, and that counted as an exit at once). Each of the three
+/// changes (guards entered through, the root through one checked point, the basis
+/// solutions in double-double) is needed here: without any one of them a trace stops or
+/// misses the tolerance.
+#[test]
+fn strip_p240_basis_loads() {
+    let spec = RectSpec {
+        nx: 241,
+        ny: 4,
+        lx: 6.0,
+        ly: 0.1,
+        ..RectSpec::press_shear()
+    };
+    let case = generate(&spec).expect("generate");
+    let cond = condensed(&case);
+    let problem = Arc::new(case.problem(None).expect("problem"));
+    let (a0, a1) = (case.alpha_start, case.alpha_end);
+    let c = compare_with_fricont(
+        &cond,
+        problem.clone(),
+        &case.f0,
+        &case.f1,
+        a0,
+        a1,
+        1e-10,
+        &mut no_progress(),
+    );
+    c.check(1e-10)
+        .expect("the affine load against the reference");
+    let want: Vec<Ev> = c
+        .reference
+        .events
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect();
+    let len = a1 - a0;
+    let (amp, omega) = (len / 100.0, 2.0 * std::f64::consts::PI * 10.0 / len);
+    // Extended precision (auto: on here), and double alone (W not refined either).
+    let double = Arc::new(
+        case.builder()
+            .extended_precision(fricont::ExtendedPrecision::Off)
+            .build()
+            .expect("problem"),
+    );
+    for (precision, problem, tol) in [("auto", problem, 5e-10), ("off", double, 5e-7)] {
+        for (name, amp) in [("identity", 0.0), ("oscillation", amp)] {
+            let ctx = format!("{name}, extended precision {precision}");
+            let phi = move |a: f64| a + amp * (omega * (a - a0)).sin();
+            let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+                w[0] = 1.0;
+                w[1] = phi(a);
+                dw[0] = 0.0;
+                dw[1] = 1.0 + amp * omega * (omega * (a - a0)).cos();
+                Ok::<(), fricont::load::LoadFailure>(())
+            };
+            let load =
+                fricont::Load::basis(vec![case.f0.clone(), case.f1.clone()], Box::new(weights))
+                    .expect("basis load");
+            let opts = fricont::PathOptions::window(a0, a1);
+            let mut path = fricont::Path::new(problem.clone(), load, opts).expect("path");
+            path.start(a0, None).expect(&ctx);
+            path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
+            assert_eq!(path.end_reason().map(|r| r.name()), Some("window"), "{ctx}");
+            let got: Vec<Ev> = path
+                .events()
+                .iter()
+                .map(|e| (phi(e.alpha), e.node, e.from, e.to))
+                .collect();
+            // φ(α_end) = α_end to rounding: the window ends where the reference's does.
+            let worst = compare_events(&got, &want, tol).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+            eprintln!("{ctx}: {} events, worst {worst:e}", got.len());
+        }
+    }
+}
+
 /// The p = 480 strip (481 × 4 nodes on (0, 12) × (0, 0.1), aspect ratio 120), the issue's
 /// other slender case: every one of its 953 transitions to 1e-10 and the whole window (in
 /// double alone 16 events differed by up to 3.4e-7). About two minutes in release, most

@@ -37,6 +37,10 @@ pub(super) struct BasisSolutions {
     y: Vec<Vec<f64>>,
     /// W times each.
     wy: Vec<Vec<f64>>,
+    /// Refined in double-double ([`Path::refine_basis`]): their combinations are then
+    /// accurate to a few roundings of their terms, and a point is not corrected from its
+    /// residual in double (which would move it by up to cond · that residual).
+    refined: bool,
 }
 
 impl BasisSolutions {
@@ -62,7 +66,7 @@ impl Path {
     /// The [`BasisSolutions`] of the current piece under a basis load, solved by updates of
     /// the path's factorisation. None for other loads, for the fresh-factorisation tracer
     /// (which keeps solving at every α, the reference), or when a solve fails its check.
-    fn basis_solutions(&self, cur: &CurrentPiece) -> Option<BasisSolutions> {
+    fn basis_solutions(&mut self, cur: &CurrentPiece) -> Option<BasisSolutions> {
         let PieceSolver::Updated(u) = &*cur.lu else {
             return None;
         };
@@ -81,43 +85,76 @@ impl Path {
         {
             return None;
         }
-        let (y, wy) = solved.into_iter().map(|s| (s.x, s.wx)).unzip();
-        Some(BasisSolutions { y, wy })
+        let (y, wy): (Vec<Vec<f64>>, Vec<Vec<f64>>) =
+            solved.into_iter().map(|s| (s.x, s.wx)).unzip();
+        Some(match self.refine_basis(cur, &y) {
+            Some(r) => {
+                let (y, wy) = r.into_iter().unzip();
+                BasisSolutions {
+                    y,
+                    wy,
+                    refined: true,
+                }
+            }
+            None => BasisSolutions {
+                y,
+                wy,
+                refined: false,
+            },
+        })
     }
 
     /// The point `(λ, d)` of the current piece at α from the guess `lam` (the basis
-    /// solutions' combination), `qg = q(α) − (g, 0)`: d by one product with W, kept when
-    /// its residual on the piece equations from the data is at rounding level, else
-    /// corrected by a checked solve from that residual. None when the correction fails
-    /// its check (or for a piece not solved by updates).
+    /// solutions' combination, `refined` when they were refined in double-double),
+    /// `qg = q(α) − (g, 0)`: d by one product with W, kept when its residual on the piece
+    /// equations from the data is at rounding level (refined: within a solve's check),
+    /// else corrected by a checked solve from that residual. None when the correction
+    /// fails its check (or for a piece not solved by updates).
     fn checked_point(
         &self,
         cur: &CurrentPiece,
         qg: &[f64],
         lam: Vec<f64>,
+        refined: bool,
     ) -> Option<(Vec<f64>, Vec<f64>)> {
         let PieceSolver::Updated(u) = &*cur.lu else {
             return None;
         };
-        let c = self.consts();
-        let w = self.problem.delassus().w();
-        let rb = self.row_bound();
-        let d = displacement_gaps(w, qg, &lam);
-        let zeros = vec![0.0; 2 * c.p];
-        let r = update::residual_rows(&c, &cur.classes, &lam, &d, &zeros);
-        let rhs = c.piece_rhs(&cur.classes, qg);
-        if update::relative_residual(&c, &cur.classes, &r, &lam, &rhs, rb) <= update::REFINE_ABOVE {
+        let (rel, d, r) = self.point_residual(cur, qg, &lam);
+        if rel <= update::REFINE_ABOVE || (refined && rel <= 1e-12) {
             return Some((lam, d));
         }
+        let c = self.consts();
+        let rhs = c.piece_rhs(&cur.classes, qg);
         let col = update::Rhs {
             b: &rhs,
             guess: Some((&lam, &r)),
         };
-        let k = u.solve_checked_many(&c, w, &[col], rb).pop()?;
+        let w = self.problem.delassus().w();
+        let k = u
+            .solve_checked_many(&c, w, &[col], self.row_bound())
+            .pop()?;
         (k.rel <= 1e-12).then(|| {
             let d = d.iter().zip(&k.wx).map(|(a, b)| a + b).collect();
             (k.x, d)
         })
+    }
+
+    /// The relative residual of `lam` on the current piece's equations from the data
+    /// (`qg = q(α) − (g, 0)`; one product with W), with its d and the residual rows.
+    fn point_residual(
+        &self,
+        cur: &CurrentPiece,
+        qg: &[f64],
+        lam: &[f64],
+    ) -> (f64, Vec<f64>, Vec<f64>) {
+        let c = self.consts();
+        let d = displacement_gaps(self.problem.delassus().w(), qg, lam);
+        let zeros = vec![0.0; 2 * c.p];
+        let r = update::residual_rows(&c, &cur.classes, lam, &d, &zeros);
+        let rhs = c.piece_rhs(&cur.classes, qg);
+        let rel = update::relative_residual(&c, &cur.classes, &r, lam, &rhs, self.row_bound());
+        (rel, d, r)
     }
 
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
@@ -441,7 +478,7 @@ impl Path {
                     let [lam, d, t, rate] = bs.at(w, dw, &qg, &dq);
                     if !exact {
                         [lam, d, t, rate]
-                    } else if let Some((lam, d)) = this.checked_point(cur, &qg, lam) {
+                    } else if let Some((lam, d)) = this.checked_point(cur, &qg, lam, bs.refined) {
                         [lam, d, t, rate]
                     } else {
                         solve(this, &qg, &dq)
@@ -460,6 +497,13 @@ impl Path {
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
         let mut h = (span / 32.0).min(hmax).min((bound - cur.alpha).abs());
         let hmin = span * 1e-12;
+        // Guards below their threshold at the piece's own point at its entry, and rising:
+        // the guards the piece was entered through, measured on its own solution, which
+        // differs from the transition point by cond · ε (more than the thresholds on the
+        // ill-conditioned pieces of a slender body). As on a straight piece, where only a
+        // decreasing guard leaves, such a guard is no exit while it rises: it counts
+        // again once it is back above its threshold, or where it turns down below it.
+        let mut below: Option<Vec<bool>> = None;
         loop {
             let tol_at = self.tol_at(&pa);
             let tol: Vec<f64> = {
@@ -468,13 +512,22 @@ impl Path {
                     .map(|row| tol_at.of(&c.guard_form(row.guard)))
                     .collect()
             };
+            let below = below.get_or_insert_with(|| {
+                (0..ga.len())
+                    .map(|k| ga[k].value < -tol[k] && dir * ga[k].slope > 0.0)
+                    .collect()
+            });
             let at_bound = (bound - pa.alpha).abs() <= h;
             let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
             let (mut pb, mut gb) = eval(self, b_alpha, false)?;
             // A guard the piece just entered (zero at a, increasing) that is negative at b:
             // the step overshoots the piece's first stretch; shorten it.
-            let premature = (0..gb.len())
-                .any(|k| ga[k].value <= tol[k] && dir * ga[k].slope > 0.0 && gb[k].value < -tol[k]);
+            let premature = (0..gb.len()).any(|k| {
+                !below[k]
+                    && ga[k].value <= tol[k]
+                    && dir * ga[k].slope > 0.0
+                    && gb[k].value < -tol[k]
+            });
             if premature && h > hmin {
                 h *= 0.5;
                 continue;
@@ -521,17 +574,22 @@ impl Path {
                     let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
                     let model = 0.5 * (v0 + v1) + 0.125 * (m0 - m1);
                     let margin = v0.min(v1).min(vm).max(tol[k]);
-                    vm < -tol[k] || (vm - model).abs() > 0.25 * margin
+                    (vm < -tol[k] && !below[k]) || (vm - model).abs() > 0.25 * margin
                 });
                 if untrusted {
                     h = 0.5 * delta.abs();
                     continue;
                 }
             }
-            let crossing: Vec<usize> = (0..gb.len()).filter(|&k| gb[k].value < -tol[k]).collect();
+            let crossing: Vec<usize> = (0..gb.len())
+                .filter(|&k| gb[k].value < -tol[k] && !(below[k] && dir * gb[k].slope > 0.0))
+                .collect();
             if crossing.is_empty() {
                 // Hermite check for a dip below zero inside the step
                 let dip = (0..gb.len()).any(|k| {
+                    if below[k] {
+                        return false;
+                    }
                     let (v0, v1) = (ga[k].value, gb[k].value);
                     let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
                     hermite_min(v0, v1, m0, m1) < -tol[k]
@@ -547,6 +605,9 @@ impl Path {
                         None => pb,
                     };
                     return Ok(Exit::Window(pt));
+                }
+                for (k, b) in below.iter_mut().enumerate() {
+                    *b = *b && gb[k].value < -tol[k];
                 }
                 pa = pb;
                 ga = gb;
@@ -572,22 +633,64 @@ impl Path {
             let (root, g) = first.expect("at least one crossing");
             let (mut pt, tab) = eval(self, root, true)?;
             // Under a basis load the root is that of the guard combined from the basis
-            // solutions, whose rounding is not the data's: the point solved for from the
-            // data there can miss the guard's zero by more than the join's tolerance
-            // (weights that cancel 100-fold; a slender p = 2000 mesh, where the data's
-            // λ(α) is itself known to ~1e-8 only). So the root is found again on the data's
-            // guard: a Newton step from the checked point, taken where the guard is well
-            // inside the join's tolerance there, else (the data's guard noisy at that
-            // level) a bracket about it and Brent: the point that ends the piece is the
-            // data's at the data's root, as where every evaluation is solved for.
-            if basis.is_some()
+            // solutions, whose terms may cancel (weights that cancel 100-fold): there the
+            // combination has lost digits, and the point solved for from the data at the
+            // root can miss the guard's zero by more than the join's tolerance. So the
+            // root is found again on the piece through that checked point `pt`:
+            // `λ(α) = λ(α_r) + Σ_j (w_j(α) − w_j(α_r)) y_j`, whose terms are small near
+            // α_r (nothing left to cancel) and smooth in α. (Checking and correcting each
+            // trial point from the data instead moved each by up to cond · its residual,
+            // differently at each α: on the ill-conditioned pieces of a slender body,
+            // cond ~ 1e8 and more, the guards at neighbouring points then disagreed by
+            // more than the join's tolerance.) A Newton step from the root, taken where
+            // the guard is well inside the join's tolerance there, else a bracket about
+            // it and Brent; the point that ends the piece is checked from the data.
+            if let Some(bs) = &basis
                 && let Some(k) = tab.iter().position(|r| r.guard == g)
+                && let Some((w_r, _)) = self.load.weights_at(root)
             {
+                let w_r = w_r.to_vec();
+                let (lam_r, q_r) = (pt.lam.clone(), pt.q.clone());
+                let d_r = self.gaps(&pt);
+                let through = |this: &mut Self, x: f64| -> Result<(Point, Vec<GuardRow>)> {
+                    let (q, dq) = this.load.q(x, this.problem.delassus())?;
+                    let Some((w, dw)) = this.load.weights_at(x) else {
+                        return Err(Error::Numerical(format!(
+                            "the basis load's weights at alpha = {x:e} are missing"
+                        )));
+                    };
+                    let mut lam = lam_r.clone();
+                    let mut d: Vec<f64> = d_r
+                        .iter()
+                        .zip(q.iter().zip(&q_r))
+                        .map(|(v, (a, b))| v + (a - b))
+                        .collect();
+                    let mut t = vec![0.0; m];
+                    let mut rate = dq.clone();
+                    for j in 0..w.len() {
+                        axpy(&mut lam, w[j] - w_r[j], &bs.y[j]);
+                        axpy(&mut d, w[j] - w_r[j], &bs.wy[j]);
+                        axpy(&mut t, dw[j], &bs.y[j]);
+                        axpy(&mut rate, dw[j], &bs.wy[j]);
+                    }
+                    t.push(1.0);
+                    let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
+                    Ok((
+                        Point {
+                            lam,
+                            alpha: x,
+                            q,
+                            dq,
+                        },
+                        table,
+                    ))
+                };
                 let (lo_a, hi_a) = (pa.alpha.min(pb.alpha), pa.alpha.max(pb.alpha));
                 let (mut x0, mut v0) = (root, tab[k].value);
                 let slope = tab[k].slope;
+                let accept = 0.25 * self.tol_at(&pt).of(&self.consts().guard_form(g));
                 let mut bracket = None;
-                let mut accept = f64::NAN;
+                let mut best: Option<Point> = None;
                 let mut step = -v0 / slope;
                 for _ in 0..8 {
                     if v0 == 0.0 || !step.is_finite() || step == 0.0 {
@@ -597,12 +700,10 @@ impl Path {
                     if x1 == x0 {
                         break;
                     }
-                    let (p1, t1) = eval(self, x1, true)?;
+                    let (p1, t1) = through(self, x1)?;
                     let v1 = t1[k].value;
-                    // Well inside the join's tolerance for the guard: taken as it is.
-                    accept = 0.25 * self.tol_at(&p1).of(&self.consts().guard_form(g));
                     if v1.abs() <= accept {
-                        pt = p1;
+                        best = Some(p1);
                         break;
                     }
                     if (v1 > 0.0) != (v0 > 0.0) || v1 == 0.0 {
@@ -610,21 +711,34 @@ impl Path {
                         break;
                     }
                     if v1.abs() < v0.abs() {
-                        (x0, v0, pt) = (x1, v1, p1);
+                        (x0, v0) = (x1, v1);
+                        best = Some(p1);
                     }
                     step *= 2.0;
                 }
-                if let Some((xa, va, xb, vb, pb1)) = bracket {
-                    let r = if vb == 0.0 {
-                        xb
+                if let Some((xa, va, xb, vb, at_b)) = bracket {
+                    best = Some(if vb == 0.0 {
+                        at_b
                     } else {
                         // Brent stops at a value within `accept` (reported as a zero).
-                        brent_fallible(xa, xb, va, vb, |x| {
-                            let v = eval(self, x, true)?.1[k].value;
+                        let r = brent_fallible(xa, xb, va, vb, |x| {
+                            let v = through(self, x)?.1[k].value;
                             Ok(if v.abs() <= accept { 0.0 } else { v })
-                        })?
+                        })?;
+                        if r == xb { at_b } else { through(self, r)?.0 }
+                    });
+                }
+                // The end point from the data: its residual on the piece's equations
+                // (one product with W) within a solve's check, else solved for there.
+                if let Some(p) = best {
+                    let qg = shift_gap(&p.q, self.problem.gap_equilibrated());
+                    let (rel, d_data, _) = self.point_residual(cur, &qg, &p.lam);
+                    pt = if rel <= 1e-12 {
+                        self.prime_gaps(p.alpha, &p.lam, d_data);
+                        p
+                    } else {
+                        eval(self, p.alpha, true)?.0
                     };
-                    pt = if r == xb { pb1 } else { eval(self, r, true)?.0 };
                 }
             }
             return Ok(Exit::Guards(pt, vec![g]));

@@ -1,4 +1,5 @@
-//! Transition points of an affine load in double-double (mixed-precision refinement).
+//! Transition points of affine loads, and the piece solutions of basis loads, in
+//! double-double (mixed-precision refinement).
 //!
 //! On slender bodies the piece matrices are so ill-conditioned that a transition point
 //! solved in double moves by up to ~1e-7 in α (cond · ε). When the problem carries its
@@ -9,7 +10,11 @@
 //! with the piece's ordinary factorisation, which converges while cond · ε < 1), then
 //! every decreasing guard's zero `α_e + s`, `s = −γ(α_e)/γ'`, in double-double, and the
 //! first one wins. The double-precision ratio test still decides which guards decrease;
-//! only where they cross, and which crosses first, comes from here.
+//! only where they cross, and which crosses first, comes from here. Under a basis load
+//! the piece's basis solutions `y_j` (see [`super::advance`]) are refined the same way
+//! and rounded ([`Path::refine_basis`]); the stepping and the roots then run in double on
+//! their combinations, accurate to a few roundings of their terms. The start point is
+//! refined under either load.
 
 use faer::MatRef;
 
@@ -112,8 +117,9 @@ struct Refiner<'a> {
     w_lo: Option<MatRef<'a, f64>>,
     classes: &'a [Class],
     solve: PieceSolve<'a>,
-    /// q0 and q1 (high, low) of the affine load.
-    q: [(Vec<f64>, Vec<f64>); 2],
+    /// The load's condensed vectors (high, low): q0 and q1 of an affine load, the q_j of
+    /// a basis load.
+    q: Vec<(Vec<f64>, Vec<f64>)>,
     gap: &'a [f64],
 }
 
@@ -121,13 +127,34 @@ impl Refiner<'_> {
     /// The constant of d at α: `q0 + α q1 − (g, 0)` in double-double.
     fn point_constant(&self, alpha: f64) -> DdVec {
         let m = self.w.nrows();
-        let [(q0, q0_lo), (q1, q1_lo)] = &self.q;
+        let ((q0, q0_lo), (q1, q1_lo)) = (&self.q[0], &self.q[1]);
         let mut out = DdVec::from(&vec![0.0; m]);
         for k in 0..m {
             let mut v = Dd::prod(alpha, q1[k]).add_f64(q0[k]);
             v = v.add_f64(q0_lo[k] + alpha * q1_lo[k]);
             if k < self.c.p {
                 v = v.add_f64(-self.gap[k]);
+            }
+            out.set(k, v);
+        }
+        out
+    }
+
+    /// The constant of d at α under a basis load with weights `w` (at α):
+    /// `Σ_j w_j q_j − (g, 0)` in double-double; with `gap` false, without the gap.
+    fn basis_constant(&self, w: &[f64], gap: bool) -> DdVec {
+        let m = self.w.nrows();
+        let mut out = DdVec::from(&vec![0.0; m]);
+        for k in 0..m {
+            let mut v = if gap && k < self.c.p {
+                Dd::new(-self.gap[k], 0.0)
+            } else {
+                Dd::ZERO
+            };
+            for (wj, (q, q_lo)) in w.iter().zip(&self.q) {
+                if *wj != 0.0 {
+                    v = v + Dd::prod(*wj, q[k]).add_f64(wj * q_lo[k]);
+                }
             }
             out.set(k, v);
         }
@@ -244,24 +271,31 @@ pub(super) fn near(lam2: &[f64], lam: &[f64]) -> bool {
 
 impl Path {
     /// The [`Refiner`] of the piece `classes` solved by `lu`; None when the problem is not
-    /// carried beyond double (see the module doc).
+    /// carried beyond double (see the module doc) or the load is a general one.
     fn refiner<'a>(
         &mut self,
         problem: &'a Problem,
         classes: &'a [Class],
         lu: &'a PieceSolver,
     ) -> Option<Refiner<'a>> {
-        if !self.polishes() {
+        if !self.problem.extended_precision() {
             return None;
         }
         let m = 2 * problem.p();
         let c = PieceConstants::of(problem);
         let del = problem.delassus();
-        // q(α) = q0 + α q1 exactly from its parts (q(0) is q0 itself).
-        let (q0, q1) = self.load.q(0.0, del).ok()?;
-        let (q0_lo, q1_lo) = match self.load.affine_lo() {
-            Some((a, b)) => (a.to_vec(), b.to_vec()),
-            None => (vec![0.0; m], vec![0.0; m]),
+        let q: Vec<(Vec<f64>, Vec<f64>)> = if self.load.is_affine() {
+            // q(α) = q0 + α q1 exactly from its parts (q(0) is q0 itself).
+            let (q0, q1) = self.load.q(0.0, del).ok()?;
+            let (q0_lo, q1_lo) = match self.load.affine_lo() {
+                Some((a, b)) => (a.to_vec(), b.to_vec()),
+                None => (vec![0.0; m], vec![0.0; m]),
+            };
+            vec![(q0, q0_lo), (q1, q1_lo)]
+        } else {
+            let qs = self.load.basis_vectors()?;
+            let lo = self.load.q_lo()?;
+            qs.iter().cloned().zip(lo.iter().cloned()).collect()
         };
         let w = del.w();
         let row_bound = self.row_bound();
@@ -288,9 +322,55 @@ impl Path {
             w_lo: del.w_lo(),
             classes,
             solve,
-            q: [(q0, q0_lo), (q1, q1_lo)],
+            q,
             gap: problem.gap_equilibrated(),
         })
+    }
+
+    /// The basis solutions `y_1 … y_J, y_g` of the piece `cur` under a basis load (see
+    /// [`super::advance::BasisSolutions`]) refined in double-double from their
+    /// double-precision solves `ys`, each rounded with `W y` (itself from `d = W y + c` in
+    /// double-double). A combination of them is then accurate to a few roundings of its
+    /// terms, where one of double-precision solves is off by cond · ε. None when the
+    /// problem is not carried beyond double, the refinement does not converge, or it lands
+    /// farther from a solve than [`near`] allows: the caller keeps the solves.
+    pub(super) fn refine_basis(
+        &mut self,
+        cur: &CurrentPiece,
+        ys: &[Vec<f64>],
+    ) -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
+        let m = 2 * self.problem.p();
+        let problem = self.problem.clone();
+        let r = self.refiner(&problem, &cur.classes, &cur.lu)?;
+        let k = r.q.len();
+        if ys.len() != k + 1 {
+            return None;
+        }
+        let pairs: Vec<(DdVec, DdVec)> = ys
+            .iter()
+            .enumerate()
+            .map(|(j, y)| {
+                let mut e = vec![0.0; k];
+                let gap = j == k;
+                if !gap {
+                    e[j] = 1.0;
+                }
+                (DdVec::from(y), r.basis_constant(&e, gap))
+            })
+            .collect();
+        let consts: Vec<DdVec> = pairs.iter().map(|(_, c)| c.clone()).collect();
+        let refined = r.refine_all(pairs)?;
+        let mut out = Vec::with_capacity(k + 1);
+        for ((x, d), (c, y)) in refined.iter().zip(consts.iter().zip(ys)) {
+            let yr: Vec<f64> = (0..m).map(|i| x.get(i).to_f64()).collect();
+            let wy: Vec<f64> = (0..m).map(|i| (d.get(i) - c.get(i)).to_f64()).collect();
+            let finite = yr.iter().chain(&wy).all(|v| v.is_finite());
+            if !finite || !near(&yr, y) {
+                return None;
+            }
+            out.push((yr, wy));
+        }
+        Some(out)
     }
 
     /// λ on the graph piece `classes` (solved by `lu`) at α, refined in double-double
@@ -306,7 +386,13 @@ impl Path {
     ) -> Option<Vec<f64>> {
         let problem = self.problem.clone();
         let r = self.refiner(&problem, classes, lu)?;
-        let c = r.point_constant(alpha);
+        let c = if self.load.is_affine() {
+            r.point_constant(alpha)
+        } else {
+            // A basis load: its weights at α.
+            self.load.q(alpha, problem.delassus()).ok()?;
+            r.basis_constant(self.load.weights_at(alpha)?.0, true)
+        };
         let (x, _) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
         let out: Vec<f64> = (0..x.hi.len()).map(|k| x.get(k).to_f64()).collect();
         (out.iter().all(|v| v.is_finite()) && near(&out, lam)).then_some(out)
@@ -318,7 +404,7 @@ impl Path {
     /// beyond double, the piece is vertical, or the refinement does not converge (the
     /// piece is too ill-conditioned even for it): the caller then works in double.
     pub(super) fn refine_piece(&mut self, cur: &CurrentPiece) -> Option<RefinedPiece> {
-        if cur.scales.is_vertical(&cur.t) {
+        if !self.load.is_affine() || cur.scales.is_vertical(&cur.t) {
             return None;
         }
         let m = 2 * self.problem.p();
@@ -395,10 +481,5 @@ impl Path {
             .map(|k| (r.lam_e.get(k) + r.lam_1.get(k) * s).to_f64())
             .collect();
         (alpha.is_finite() && lam.iter().all(|v| v.is_finite())).then_some((lam, alpha, g))
-    }
-
-    /// True when transition points are computed in double-double (see the module doc).
-    fn polishes(&self) -> bool {
-        self.load.is_affine() && self.problem.extended_precision()
     }
 }
