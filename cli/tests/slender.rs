@@ -311,6 +311,17 @@ fn slender(name: &str, spec: RectSpec, tol: f64) {
     );
 }
 
+/// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.
+fn strip(p: usize) -> RectSpec {
+    RectSpec {
+        nx: p + 1,
+        ny: 4,
+        lx: p as f64 / 40.0,
+        ly: 0.1,
+        ..RectSpec::press_shear()
+    }
+}
+
 fn beam(friction: f64) -> RectSpec {
     RectSpec {
         nx: 121,
@@ -338,17 +349,7 @@ fn beam_48_by_1_p120_friction_1() {
 /// polishes each transition point; in double alone two α differed by 2.3e-8 and 1.5e-8.
 #[test]
 fn strip_p240() {
-    slender(
-        "strip p = 240",
-        RectSpec {
-            nx: 241,
-            ny: 4,
-            lx: 6.0,
-            ly: 0.1,
-            ..RectSpec::press_shear()
-        },
-        1e-10,
-    );
+    slender("strip p = 240", strip(240), 1e-10);
 }
 
 /// Basis loads on the p = 240 strip, against the reference by reparametrisation: the
@@ -370,14 +371,7 @@ fn strip_p240() {
 /// misses the tolerance.
 #[test]
 fn strip_p240_basis_loads() {
-    let spec = RectSpec {
-        nx: 241,
-        ny: 4,
-        lx: 6.0,
-        ly: 0.1,
-        ..RectSpec::press_shear()
-    };
-    let case = generate(&spec).expect("generate");
+    let case = generate(&strip(240)).expect("generate");
     let cond = condensed(&case);
     let problem = Arc::new(case.problem(None).expect("problem"));
     let (a0, a1) = (case.alpha_start, case.alpha_end);
@@ -393,12 +387,7 @@ fn strip_p240_basis_loads() {
     );
     c.check(1e-10)
         .expect("the affine load against the reference");
-    let want: Vec<Ev> = c
-        .reference
-        .events
-        .iter()
-        .map(|e| (e.alpha, e.node, e.from, e.to))
-        .collect();
+    let want = ref_events(&c.reference);
     let len = a1 - a0;
     let (amp, omega) = (len / 100.0, 2.0 * std::f64::consts::PI * 10.0 / len);
     // Extended precision (auto: on here), and double alone (W not refined either).
@@ -445,17 +434,7 @@ fn strip_p240_basis_loads() {
 /// of it the reference's fresh double-double LU per piece.
 #[test]
 fn strip_p480() {
-    slender(
-        "strip p = 480",
-        RectSpec {
-            nx: 481,
-            ny: 4,
-            lx: 12.0,
-            ly: 0.1,
-            ..RectSpec::press_shear()
-        },
-        1e-10,
-    );
+    slender("strip p = 480", strip(480), 1e-10);
 }
 
 /// The tracer alone on data exact in double: the reference's condensation of the beam
