@@ -48,13 +48,26 @@ impl BasisSolutions {
     /// `qg = q(α) − (g, 0)` and `dq = q'(α)`.
     fn at(&self, w: &[f64], dw: &[f64], qg: &[f64], dq: &[f64]) -> [Vec<f64>; 4] {
         let k = w.len();
-        let mut lam = self.y[k].clone();
-        let mut d: Vec<f64> = qg.iter().zip(&self.wy[k]).map(|(a, b)| a + b).collect();
+        let d: Vec<f64> = qg.iter().zip(&self.wy[k]).map(|(a, b)| a + b).collect();
+        self.combine(self.y[k].clone(), d, w, dw, dq)
+    }
+
+    /// `(λ0 + Σ_j c_j y_j, d0 + Σ_j c_j W y_j, Σ_j w'_j y_j, q' + Σ_j w'_j W y_j)`: the
+    /// point, its d, dλ/dα and the rate of d, from a point `(λ0, d0)` of the piece and
+    /// the weights' changes `c` since it ([`Self::at`]: from y_g).
+    fn combine(
+        &self,
+        mut lam: Vec<f64>,
+        mut d: Vec<f64>,
+        c: &[f64],
+        dw: &[f64],
+        dq: &[f64],
+    ) -> [Vec<f64>; 4] {
         let mut dl = vec![0.0; lam.len()];
         let mut rate = dq.to_vec();
-        for j in 0..k {
-            axpy(&mut lam, w[j], &self.y[j]);
-            axpy(&mut d, w[j], &self.wy[j]);
+        for j in 0..c.len() {
+            axpy(&mut lam, c[j], &self.y[j]);
+            axpy(&mut d, c[j], &self.wy[j]);
             axpy(&mut dl, dw[j], &self.y[j]);
             axpy(&mut rate, dw[j], &self.wy[j]);
         }
@@ -659,20 +672,13 @@ impl Path {
                             "the basis load's weights at alpha = {x:e} are missing"
                         )));
                     };
-                    let mut lam = lam_r.clone();
-                    let mut d: Vec<f64> = d_r
+                    let d: Vec<f64> = d_r
                         .iter()
                         .zip(q.iter().zip(&q_r))
                         .map(|(v, (a, b))| v + (a - b))
                         .collect();
-                    let mut t = vec![0.0; m];
-                    let mut rate = dq.clone();
-                    for j in 0..w.len() {
-                        axpy(&mut lam, w[j] - w_r[j], &bs.y[j]);
-                        axpy(&mut d, w[j] - w_r[j], &bs.wy[j]);
-                        axpy(&mut t, dw[j], &bs.y[j]);
-                        axpy(&mut rate, dw[j], &bs.wy[j]);
-                    }
+                    let c: Vec<f64> = w.iter().zip(&w_r).map(|(a, b)| a - b).collect();
+                    let [lam, d, mut t, rate] = bs.combine(lam_r.clone(), d, &c, dw, &dq);
                     t.push(1.0);
                     let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
                     Ok((
