@@ -2,10 +2,10 @@
 //! zero is found (issue: steps certified only by end-point derivatives skipped them).
 //!
 //! One node, A = I (2 dofs), N = [1, 0], T = [0, 1], no gap, load f(α) = (c(α), 0) with
-//! c(α) = 0.9 + sin(20α): the node is open where c ≤ 0 (u = f) and sticks where c > 0
+//! c(α) = c0 + sin(ω α + φ): the node is open where c ≤ 0 (u = f) and sticks where c > 0
 //! (u_n = 0, λν = −c, λt = 0), so the transitions are exactly the roots of c on the
-//! window, where sin(20α) = −0.9: 64 of them on [−5, 5], each open for a stretch of
-//! α of width 0.045 only (1/220 of the window).
+//! window, where sin(ω α + φ) = −c0. With c0 = 0.9 and ω = 20, 64 of them on [−5, 5],
+//! each open for a stretch of α of width 0.045 only (1/220 of the window).
 
 mod common;
 
@@ -15,29 +15,46 @@ use std::sync::Arc;
 use fricont::load::LoadFailure;
 use fricont::{Class, CsrMatrix, EndReason, Load, Path, PathOptions, ProblemBuilder, Storage};
 
-fn roots(a0: f64, a1: f64) -> Vec<(f64, Class, Class)> {
-    let s = (-0.9f64).asin(); // in (−π/2, 0)
+/// The roots of c(α) = c0 + sin(ω α + φ) strictly between a0 and a1 in the order of
+/// tracing from a0, with the classes before and after.
+fn roots(c0: f64, omega: f64, phase: f64, a0: f64, a1: f64) -> Vec<(f64, Class, Class)> {
+    let s = (-c0).asin(); // in (−π/2, 0)
+    let (lo, hi) = (a0.min(a1), a0.max(a1));
     let mut out = Vec::new();
-    for k in -40..40 {
+    let kmax = (omega * hi.abs().max(lo.abs()) / (2.0 * PI)).ceil() as i64 + 2;
+    for k in -kmax..=kmax {
         let base = 2.0 * PI * k as f64;
-        // sin decreasing through −0.9 at π − s: contact → open; increasing at 2π + s: open → contact
-        let down = (PI - s + base) / 20.0;
-        let up = (2.0 * PI + s + base) / 20.0;
+        // sin decreasing through −c0 at π − s: contact → open; increasing at 2π + s:
+        // open → contact (the other way round when traced downward)
+        let down = (PI - s + base - phase) / omega;
+        let up = (2.0 * PI + s + base - phase) / omega;
         for (a, from, to) in [
             (down, Class::Stick, Class::Open),
             (up, Class::Open, Class::Stick),
         ] {
-            if a > a0 && a < a1 {
-                out.push((a, from, to));
+            if a > lo && a < hi {
+                out.push(if a1 > a0 {
+                    (a, from, to)
+                } else {
+                    (a, to, from)
+                });
             }
         }
     }
     out.sort_by(|x, y| x.0.total_cmp(&y.0));
+    if a1 < a0 {
+        out.reverse();
+    }
     out
 }
 
-#[test]
-fn one_node_sine_load_finds_every_transition() {
+/// Traces the one node under c0 + sin(ω α + φ) (given with its derivative, or without
+/// it: central differences) from a0 to a1 and returns the events.
+fn trace_one_node(
+    (c0, omega, phase): (f64, f64, f64),
+    (a0, a1): (f64, f64),
+    with_derivative: bool,
+) -> Vec<(f64, Class, Class)> {
     let a = CsrMatrix::from_dense(2, 2, &[1.0, 0.0, 0.0, 1.0]).unwrap();
     let n = CsrMatrix::from_dense(1, 2, &[1.0, 0.0]).unwrap();
     let t = CsrMatrix::from_dense(1, 2, &[0.0, 1.0]).unwrap();
@@ -47,37 +64,73 @@ fn one_node_sine_load_finds_every_transition() {
             .build()
             .unwrap(),
     );
-    let f = Box::new(|al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
-        out[0] = 0.9 + (20.0 * al).sin();
+    let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+        out[0] = c0 + (omega * al + phase).sin();
         out[1] = 0.0;
         Ok(())
     });
-    let df = Box::new(|al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
-        out[0] = 20.0 * (20.0 * al).cos();
+    let df = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+        out[0] = omega * (omega * al + phase).cos();
         out[1] = 0.0;
         Ok(())
     });
-    let (a0, a1) = (-5.0, 5.0);
-    let mut path = Path::new(
-        problem,
-        Load::general(2, f, Some(df)),
-        PathOptions::window(a0, a1),
-    )
-    .unwrap();
+    let load = Load::general(2, f, with_derivative.then_some(df as _));
+    let mut path = Path::new(problem, load, PathOptions::window(a0, a1)).unwrap();
     path.start(a0, None).unwrap();
     assert_eq!(path.run().unwrap(), EndReason::Window);
-    let want = roots(a0, a1);
-    assert_eq!(want.len(), 64);
-    let got: Vec<(f64, Class, Class)> = path
-        .events()
+    path.events()
         .iter()
         .map(|e| (e.alpha, e.from, e.to))
-        .collect();
+        .collect()
+}
+
+#[test]
+fn one_node_sine_load_finds_every_transition() {
+    let want = roots(0.9, 20.0, 0.0, -5.0, 5.0);
+    assert_eq!(want.len(), 64);
+    let got = trace_one_node((0.9, 20.0, 0.0), (-5.0, 5.0), true);
     assert_eq!(got.len(), want.len(), "events {got:?}");
     for (g, w) in got.iter().zip(&want) {
         assert!((g.0 - w.0).abs() <= 1e-10, "α {} expected {}", g.0, w.0);
         assert_eq!((g.1, g.2), (w.1, w.2), "at α = {}", w.0);
     }
+}
+
+/// The same node under sines of other frequencies, phases and depths, traced upward and
+/// downward, with and without the load's derivative: the steps' grid then falls
+/// differently on the sine each time, and no excursion may be skipped on any of them.
+#[test]
+fn one_node_sine_loads_at_many_phases_frequencies_and_directions() {
+    let mut cases = 0;
+    for c0 in [0.9, 0.5, 0.97] {
+        for omega in [7.3, 20.0, 31.7, 53.0] {
+            for phase in [0.0, 0.37, 1.1, 2.9, 4.4] {
+                for (a0, a1) in [(-5.0, 5.0), (5.0, -5.0), (-1.3, 3.9)] {
+                    let want = roots(c0, omega, phase, a0, a1);
+                    // a start at a transition point is not this test's subject
+                    let c_start = c0 + (omega * a0 + phase).sin();
+                    if c_start.abs() < 1e-3 {
+                        continue;
+                    }
+                    let with_derivative = cases % 2 == 0;
+                    let got = trace_one_node((c0, omega, phase), (a0, a1), with_derivative);
+                    let case = format!("c0 {c0} ω {omega} φ {phase} window ({a0}, {a1})");
+                    assert_eq!(got.len(), want.len(), "{case}: events {got:?}");
+                    for (g, w) in got.iter().zip(&want) {
+                        assert!(
+                            (g.0 - w.0).abs() <= 1e-9,
+                            "{case}: α {} expected {}",
+                            g.0,
+                            w.0
+                        );
+                        assert_eq!((g.1, g.2), (w.1, w.2), "{case}: at α = {}", w.0);
+                    }
+                    cases += 1;
+                }
+            }
+        }
+    }
+    assert!(cases >= 150, "only {cases} cases");
 }
 
 /// A finite-element mesh under `f(α) = f0 + A sin(50 α) f1` over three periods: every

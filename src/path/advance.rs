@@ -2,7 +2,7 @@
 //! ([`Path::exit_linear`]) and the certified steps of a nonlinear load
 //! ([`Path::exit_graph`]), both on the table of guard values and derivatives.
 
-use super::roots::{brent_fallible, hermite_min};
+use super::roots::{brent_fallible, hermite_min, newton_bracketed};
 use super::*;
 use crate::dense::axpy;
 
@@ -508,7 +508,14 @@ impl Path {
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
-        let mut h = (span / 32.0).min(hmax).min((bound - cur.alpha).abs());
+        let first = self
+            .graph_step
+            .get()
+            .map_or(span / 32.0, |h| (2.0 * h).max(span / 1024.0));
+        let mut h = first
+            .min(span / 32.0)
+            .min(hmax)
+            .min((bound - cur.alpha).abs());
         let hmin = span * 1e-12;
         // Guards below their threshold at the piece's own point at its entry, and rising:
         // the guards the piece was entered through, measured on its own solution, which
@@ -517,6 +524,7 @@ impl Path {
         // decreasing guard leaves, such a guard is no exit while it rises: it counts
         // again once it is back above its threshold, or where it turns down below it.
         let mut below: Option<Vec<bool>> = None;
+        let mut ahead: Option<(Point, Vec<GuardRow>)> = None;
         loop {
             let tol_at = self.tol_at(&pa);
             let tol: Vec<f64> = {
@@ -532,7 +540,11 @@ impl Path {
             });
             let at_bound = (bound - pa.alpha).abs() <= h;
             let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
-            let (mut pb, mut gb) = eval(self, b_alpha, false)?;
+            // The midpoint of an untrusted step is the end of the step that follows.
+            let (mut pb, mut gb) = match ahead.take() {
+                Some(m) if m.0.alpha == b_alpha => m,
+                _ => eval(self, b_alpha, false)?,
+            };
             // A guard the piece just entered (zero at a, increasing) that is negative at b:
             // the step overshoots the piece's first stretch; shorten it.
             let premature = (0..gb.len()).any(|k| {
@@ -576,24 +588,38 @@ impl Path {
             let delta = pb.alpha - pa.alpha;
             // The step is trusted only where the cubic Hermite model of every guard (from
             // the values and slopes at both ends) predicts a fresh evaluation at the
-            // midpoint to within a quarter of the guard's smallest margin on the step: a
-            // load that changes faster than the step resolves (an excursion of a guard
-            // below zero and back inside one step) fails this test and shortens the step.
-            // A guard already negative at the midpoint is a crossing inside the step.
+            // midpoint to within a quarter of the guard's smallest margin on the step (of
+            // its values at both ends for a guard that changes sign, whose root is then
+            // found on the guard itself): a load that changes faster than the step
+            // resolves (an excursion of a guard below zero and back inside one step)
+            // fails this test and shortens the step to its first half. A guard already
+            // negative at the midpoint is a crossing inside the first half.
             if h > hmin {
-                let (_, gm) = eval(self, pa.alpha + 0.5 * delta, false)?;
+                let pm = eval(self, pa.alpha + 0.5 * delta, false)?;
+                let gm = &pm.1;
                 let untrusted = (0..gb.len()).any(|k| {
                     let (v0, v1, vm) = (ga[k].value, gb[k].value, gm[k].value);
                     let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
                     let model = 0.5 * (v0 + v1) + 0.125 * (m0 - m1);
-                    let margin = v0.min(v1).min(vm).max(tol[k]);
-                    (vm < -tol[k] && !below[k]) || (vm - model).abs() > 0.25 * margin
+                    let margin = if v0 > tol[k] && v1 < -tol[k] {
+                        v0.min(-v1)
+                    } else {
+                        v0.min(v1).min(vm).max(tol[k])
+                    };
+                    // the model's slope at the midpoint, against the guard's there (an
+                    // error symmetric about the midpoint leaves it, an asymmetric one not)
+                    let model_slope = 1.5 * (v1 - v0) - 0.25 * (m0 + m1);
+                    (vm < -tol[k] && !below[k])
+                        || (vm - model).abs() > 0.25 * margin
+                        || (gm[k].slope * delta - model_slope).abs() > margin
                 });
                 if untrusted {
                     h = 0.5 * delta.abs();
+                    ahead = Some(pm);
                     continue;
                 }
             }
+            self.graph_step.set(Some(delta.abs()));
             let crossing: Vec<usize> = (0..gb.len())
                 .filter(|&k| gb[k].value < -tol[k] && !(below[k] && dir * gb[k].slope > 0.0))
                 .collect();
@@ -627,7 +653,10 @@ impl Path {
                 h = (2.0 * h).min(hmax);
                 continue;
             }
-            // Brent on each crossing guard; the earliest root wins.
+            // The root of each crossing guard (safeguarded Newton on its values and
+            // slopes), to within 64 roundings of the guard's own scale (its tolerance is
+            // `zero_tol` of that scale): the earliest root wins.
+            let fine = (64.0 * f64::EPSILON / self.opts.zero_tol).min(0.25);
             let mut first: Option<(f64, Guard)> = None;
             for &k in &crossing {
                 let g = gb[k].guard;
@@ -637,7 +666,15 @@ impl Path {
                 let root = if fa <= 0.0 {
                     a0
                 } else {
-                    brent_fallible(a0, b0, fa, fb, |x| Ok(eval(self, x, false)?.1[k].value))?
+                    newton_bracketed(
+                        (a0, fa, ga[k].slope),
+                        (b0, fb, gb[k].slope),
+                        fine * tol[k],
+                        |x| {
+                            let rows = eval(self, x, false)?.1;
+                            Ok((rows[k].value, rows[k].slope))
+                        },
+                    )?
                 };
                 if first.is_none_or(|f| dir * (root - f.0) < 0.0) {
                     first = Some((root, g));
@@ -645,6 +682,21 @@ impl Path {
             }
             let (root, g) = first.expect("at least one crossing");
             let (mut pt, tab) = eval(self, root, true)?;
+            // Up to the root, no guard may dip below zero: neither at the root itself nor
+            // in its cubic Hermite model on [α_a, root] (the models were trusted on the
+            // whole step). Else the step is shortened to the first half of that stretch.
+            let stretch = root - pa.alpha;
+            let dips = (0..tab.len()).any(|k| {
+                if below[k] || tab[k].guard == g {
+                    return false;
+                }
+                let (m0, m1) = (ga[k].slope * stretch, tab[k].slope * stretch);
+                tab[k].value < -tol[k] || hermite_min(ga[k].value, tab[k].value, m0, m1) < -tol[k]
+            });
+            if dips && h > hmin && stretch != 0.0 {
+                h = 0.5 * stretch.abs();
+                continue;
+            }
             // Under a basis load the root is that of the guard combined from the basis
             // solutions, whose terms may cancel (weights that cancel 100-fold): there the
             // combination has lost digits, and the point solved for from the data at the

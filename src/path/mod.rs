@@ -53,7 +53,7 @@ pub struct PathOptions {
     /// Largest α step of the step control of a basis or general (nonlinear) load (α
     /// units; default `None`: 1/8 of the window's length). Each step is also shortened
     /// until the cubic Hermite model of every guard predicts a fresh evaluation at the
-    /// step's midpoint; a load that varies faster than that test can see (an excursion of
+    /// step's midpoint, value and slope; a load that varies faster than that test can see (an excursion of
     /// a guard below zero and back, narrower than the step at which the test passes) is
     /// caught only by a step no longer than the excursion: set this to a fraction of the
     /// shortest period or feature of a load that oscillates. No effect on affine loads,
@@ -254,6 +254,9 @@ pub struct Path {
     gaps_cache: RefCell<Vec<GapsAt>>,
     /// The last point's "at zero" thresholds with its (α, λ).
     tol_cache: RefCell<Option<(f64, Vec<f64>, Tol)>>,
+    /// The last step (α units) that the march of a nonlinear load trusted: the next
+    /// piece's march starts from twice that, not from the window's scale.
+    graph_step: Cell<Option<f64>>,
 }
 
 /// The traced data and the current position.
@@ -640,6 +643,7 @@ impl Path {
             row_bound: Cell::new(None),
             gaps_cache: RefCell::new(Vec::new()),
             tol_cache: RefCell::new(None),
+            graph_step: Cell::new(None),
         })
     }
 

@@ -111,6 +111,59 @@ pub(super) fn brent(a: f64, b: f64, fa: f64, fb: f64, mut f: impl FnMut(f64) -> 
     b
 }
 
+/// A root of `f` between `a` and `b`, where `f` changes sign, from values and slopes
+/// (`f` returns both): Newton steps kept inside the bracket, which shrinks at every
+/// evaluation, and a bisection wherever Newton would leave it or not halve the step
+/// before last (safeguarded Newton, as `rtsafe` in Numerical Recipes). Ends at the last
+/// point evaluated, once its value is within `accept` of zero, the Newton step from it is
+/// below machine precision in the argument, or the bracket is at machine precision. The
+/// first error of `f` ends the search and is returned.
+pub(super) fn newton_bracketed<E>(
+    (a, fa, sa): (f64, f64, f64),
+    (b, fb, sb): (f64, f64, f64),
+    accept: f64,
+    mut f: impl FnMut(f64) -> Result<(f64, f64), E>,
+) -> Result<f64, E> {
+    let (mut lo, mut hi, mut f_lo) = if a < b { (a, b, fa) } else { (b, a, fb) };
+    let (mut x, mut fx, mut sx) = if fa.abs() <= fb.abs() {
+        (a, fa, sa)
+    } else {
+        (b, fb, sb)
+    };
+    let mut dx = hi - lo;
+    let mut dx_old = dx;
+    for _ in 0..200 {
+        let newton = x - fx / sx;
+        let eps = 2.0 * f64::EPSILON * x.abs();
+        if fx.abs() <= accept || (newton - x).abs() <= eps || hi - lo <= 2.0 * eps {
+            break;
+        }
+        let y = if newton > lo && newton < hi && (2.0 * fx).abs() <= (dx_old * sx).abs() {
+            dx_old = dx;
+            dx = (newton - x).abs();
+            newton
+        } else {
+            dx_old = dx;
+            dx = 0.5 * (hi - lo);
+            lo + dx
+        };
+        if y == x || y <= lo || y >= hi {
+            break;
+        }
+        (fx, sx) = f(y)?;
+        x = y;
+        if fx.is_nan() {
+            break;
+        }
+        if (fx > 0.0) == (f_lo > 0.0) {
+            (lo, f_lo) = (x, fx);
+        } else {
+            hi = x;
+        }
+    }
+    Ok(x)
+}
+
 /// [`brent`] on a fallible `f`: the first error ends the search and is returned.
 pub(super) fn brent_fallible<E>(
     a: f64,
@@ -142,6 +195,28 @@ mod tests {
         let f = |x: f64| 2.0 - x * x * x;
         let r = brent(0.0, 2.0, f(0.0), f(2.0), f);
         assert!((r - 2f64.cbrt()).abs() < 4.0 * f64::EPSILON);
+    }
+
+    #[test]
+    fn newton_bracketed_finds_roots() {
+        // a smooth root, from either side, to machine precision
+        let f = |x: f64| Ok::<_, ()>((2.0 - x * x * x, -3.0 * x * x));
+        for (a, b) in [(0.0, 2.0), (2.0, 0.0)] {
+            let (fa, sa) = f(a).unwrap();
+            let (fb, sb) = f(b).unwrap();
+            let r = newton_bracketed((a, fa, sa), (b, fb, sb), 0.0, f).unwrap();
+            assert!((r - 2f64.cbrt()).abs() < 4.0 * f64::EPSILON, "{r}");
+        }
+        // a flat start (zero slope at both ends): bisection until Newton takes over
+        let g = |x: f64| Ok::<_, ()>(((x - 0.3).powi(3), 3.0 * (x - 0.3).powi(2)));
+        let (fa, fb) = (g(0.3 - 1.0).unwrap().0, g(0.3 + 2.0).unwrap().0);
+        let r = newton_bracketed((-0.7, fa, 0.0), (2.3, fb, 0.0), 1e-30, g).unwrap();
+        assert!((r - 0.3).abs() < 1e-10, "{r}");
+        // the error of f is passed on
+        let e = newton_bracketed((0.0, 1.0, -1.0), (2.0, -1.0, -1.0), 0.0, |_| {
+            Err::<(f64, f64), _>(7)
+        });
+        assert_eq!(e, Err(7));
     }
 
     #[test]
