@@ -368,7 +368,8 @@ fn strip_p240() {
 /// through below its threshold, and that counted as an exit at once). Each of the three
 /// changes (guards entered through, the root through one checked point, the basis
 /// solutions in double-double) is needed here: without any one of them a trace stops or
-/// misses the tolerance.
+/// misses the tolerance. The same loads given as general loads (f(α) itself, solved
+/// afresh at each α in double) may stop loudly, never end with other events.
 #[test]
 fn strip_p240_basis_loads() {
     let case = generate(&strip(240)).expect("generate");
@@ -397,7 +398,10 @@ fn strip_p240_basis_loads() {
             .build()
             .expect("problem"),
     );
-    for (precision, problem, tol) in [("auto", problem, 5e-10), ("off", double, 5e-7)] {
+    for (precision, problem, tol) in [
+        ("auto", problem.clone(), 5e-10),
+        ("off", double.clone(), 5e-7),
+    ] {
         for (name, amp) in [("identity", 0.0), ("oscillation", amp)] {
             let ctx = format!("{name}, extended precision {precision}");
             let phi = move |a: f64| a + amp * (omega * (a - a0)).sin();
@@ -424,6 +428,47 @@ fn strip_p240_basis_loads() {
             // φ(α_end) = α_end to rounding: the window ends where the reference's does.
             let worst = compare_events(&got, &want, tol).unwrap_or_else(|e| panic!("{ctx}: {e}"));
             eprintln!("{ctx}: {} events, worst {worst:e}", got.len());
+        }
+    }
+    // The same loads as general loads, f(α) itself: each α is solved afresh in double,
+    // whose solutions here differ between neighbouring α by more than the guards'
+    // thresholds (cond · ε). The trace may stop loudly, but where it ends in the window its
+    // events are the reference's (in double, as the basis load's: 5e-7). Before the march
+    // checked its unresolvable steps, the oscillation ended "window" after two spurious
+    // events (a fold) at the window's start.
+    for (precision, problem) in [("auto", problem), ("off", double)] {
+        for (name, amp) in [("identity", 0.0), ("oscillation", amp)] {
+            let ctx = format!("general load, {name}, extended precision {precision}");
+            let phi = move |a: f64| a + amp * (omega * (a - a0)).sin();
+            let (f0, f1) = (case.f0.clone(), case.f1.clone());
+            let f = move |a: f64, out: &mut [f64]| {
+                let s = phi(a);
+                for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+                    *o = x + s * y;
+                }
+                Ok::<(), fricont::load::LoadFailure>(())
+            };
+            let load = fricont::Load::general(case.f0.len(), Box::new(f), None);
+            let opts = fricont::PathOptions::window(a0, a1);
+            let mut path = fricont::Path::new(problem.clone(), load, opts).expect("path");
+            path.start(a0, None).expect(&ctx);
+            match path.run() {
+                Err(fricont::Error::Numerical(msg)) => {
+                    eprintln!("{ctx}: stopped loudly after {}: {msg}", path.events().len());
+                }
+                Err(e) => panic!("{ctx}: {e}"),
+                Ok(_) => {
+                    assert_eq!(path.end_reason().map(|r| r.name()), Some("window"), "{ctx}");
+                    let got: Vec<Ev> = path
+                        .events()
+                        .iter()
+                        .map(|e| (phi(e.alpha), e.node, e.from, e.to))
+                        .collect();
+                    let worst =
+                        compare_events(&got, &want, 5e-7).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+                    eprintln!("{ctx}: {} events, worst {worst:e}", got.len());
+                }
+            }
         }
     }
 }

@@ -653,6 +653,27 @@ impl Path {
                 h = (2.0 * h).min(hmax);
                 continue;
             }
+            // A step too short to be tested (h ≤ hmin: halved down to there) over which a
+            // crossing guard's values disagree with its slopes by more than its threshold:
+            // the solves at neighbouring α differ by more than the thresholds (cond · ε of
+            // an ill-conditioned piece), so no crossing can be located on them; taking one
+            // anyway reported spurious transitions and folds. Stop loudly instead.
+            if h <= hmin {
+                for &k in &crossing {
+                    let drift =
+                        gb[k].value - ga[k].value - 0.5 * (ga[k].slope + gb[k].slope) * delta;
+                    if drift.abs() > tol[k] {
+                        let node = gb[k].guard.node + 1;
+                        return Err(Error::Numerical(format!(
+                            "the load's solutions at alpha = {:e} and {:e} disagree by {:e} on a guard of node {node}, more than its zero threshold {:e}: the solves of this nonlinear load are too inaccurate here (cond · eps) to locate a transition; give the load as affine or basis (carried in extended precision), or raise zero_tol",
+                            pa.alpha,
+                            pb.alpha,
+                            drift.abs(),
+                            tol[k]
+                        )));
+                    }
+                }
+            }
             // The root of each crossing guard (safeguarded Newton on its values and
             // slopes), to within 64 roundings of the guard's own scale (its tolerance is
             // `zero_tol` of that scale): the earliest root wins.
