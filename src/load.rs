@@ -174,10 +174,19 @@ pub(crate) struct BoundLoad {
     /// point ([`Self::term_magnitude_rows`]) must not depend on which α was evaluated
     /// since (the tracer evaluates the entry of a piece after its exit point).
     recent_weights: Vec<(f64, Vec<f64>)>,
-    /// A general load's last `(α, q, q')`: the tracer often asks again at the same α (a
+    /// A general load's last evaluation: the tracer often asks again at the same α (a
     /// root, then the join at it), and each evaluation costs the user's callbacks and a
     /// solve with A.
-    last_general: Option<(f64, Vec<f64>, Vec<f64>)>,
+    last_general: Option<GeneralEval>,
+}
+
+/// A general load evaluated at `alpha`: `q(α)`, `q'(α)` and, where W was refined, the
+/// low part of q (see [`BoundLoad::general_q_lo`]).
+struct GeneralEval {
+    alpha: f64,
+    q: Vec<f64>,
+    dq: Vec<f64>,
+    q_lo: Option<Vec<f64>>,
 }
 
 impl BoundLoad {
@@ -282,6 +291,14 @@ impl BoundLoad {
     #[cfg_attr(not(test), allow(dead_code))]
     pub(crate) fn q_lo(&self) -> Option<&[Vec<f64>]> {
         self.q_lo.as_deref()
+    }
+
+    /// For a general load on a problem whose W was refined ([`Delassus::w_lo`]): the
+    /// condensed load `q` of its last evaluation by [`Self::q`] and its low part (`q +
+    /// q_lo` is `B A⁻¹ f(α)` to double-double accuracy), 2p entries each. None otherwise.
+    pub(crate) fn general_q_lo(&self) -> Option<(&[f64], &[f64])> {
+        let e = self.last_general.as_ref()?;
+        Some((&e.q, e.q_lo.as_deref()?))
     }
 
     /// For a basis load: its condensed vectors `q_j`, so that `q(α) = Σ_j w_j(α) q_j`.
@@ -454,10 +471,10 @@ impl BoundLoad {
                 Ok((q, dq))
             }
             Load::General { n, f, df } => {
-                if let Some((a, q, dq)) = &self.last_general
-                    && *a == alpha
+                if let Some(e) = &self.last_general
+                    && e.alpha == alpha
                 {
-                    return Ok((q.clone(), dq.clone()));
+                    return Ok((e.q.clone(), e.dq.clone()));
                 }
                 let n = *n;
                 let mut fv = vec![0.0; n];
@@ -484,7 +501,15 @@ impl BoundLoad {
                 let mut qs = del.condense_many(&[&fv, &d])?;
                 let dq = qs.pop().expect("two columns");
                 let q = qs.pop().expect("two columns");
-                self.last_general = Some((alpha, q.clone(), dq.clone()));
+                // Where W was refined, q's low part too: the tracer refines its points
+                // under this load on q + q_lo.
+                let q_lo = del.condense_lo(&[&fv], &[&q])?.and_then(|mut v| v.pop());
+                self.last_general = Some(GeneralEval {
+                    alpha,
+                    q: q.clone(),
+                    dq: dq.clone(),
+                    q_lo,
+                });
                 Ok((q, dq))
             }
         }

@@ -361,7 +361,12 @@ pub enum Storage {
 /// the low parts `W_lo` and `q_lo` of `W = W_hi + W_lo` and `q = q_hi + q_lo` by
 /// mixed-precision iterative refinement with its Cholesky factor of A (residuals in
 /// double-double, corrections in double), and the tracer locates transition points in
-/// double-double. `W_hi` and `q_hi` are then W and q correctly rounded to double.
+/// double-double. `W_hi` and `q_hi` are then W and q correctly rounded to double. Under
+/// a basis load each piece's basis solutions are refined so; under a general load each
+/// evaluation at an α is (`q(α)`'s low part by one more refinement with the factor of A,
+/// then the point), which about doubles its cost: in double alone the solutions at
+/// neighbouring α of a slender body disagree by more than the guards' thresholds, and
+/// the trace stops with [`crate::Error::Numerical`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ExtendedPrecision {
     /// Refine when W is ill-conditioned and refining is affordable: the estimate

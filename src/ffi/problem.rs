@@ -886,7 +886,10 @@ pub unsafe extern "C" fn fricont_problem_set_threads(
 /// W) it is traced in extended precision all the same. Like the friction, a change drops
 /// the factorisation: the next build (explicit or by `fricont_path_new_*`) factorises A
 /// again; existing paths are not affected. Query the outcome with
-/// `fricont_problem_extended_precision`.
+/// `fricont_problem_extended_precision`. Under a general load
+/// (`fricont_path_new_general`) each evaluation is refined too, at about twice its cost:
+/// in double alone the solutions at neighbouring α of a slender body disagree by more
+/// than the transition thresholds, and the trace stops with `FRICONT_ERR_NUMERICAL`.
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (`mode` not
 /// 0, 1 or 2; the setting is then unchanged), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.

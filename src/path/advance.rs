@@ -4,7 +4,7 @@
 
 use super::roots::{brent_fallible, hermite_min, newton_bracketed};
 use super::*;
-use crate::dense::axpy;
+use crate::dense::{axpy, mat_mul};
 
 /// A guard with its value and its derivative along the tangent.
 pub(super) struct GuardRow {
@@ -497,7 +497,24 @@ impl Path {
                         solve(this, &qg, &dq)
                     }
                 }
-                _ => solve(this, &qg, &dq),
+                _ => {
+                    let [mut lam, mut d, t, rate] = solve(this, &qg, &dq);
+                    // A general load on a problem carried beyond double: the point refined
+                    // in double-double (the solves at neighbouring α otherwise differ by
+                    // cond · ε, more than the guards' thresholds on a slender body), its d
+                    // from it; the rates stay in double.
+                    if basis.is_none()
+                        && let Some(refined) = this.polish_point(&classes, &cur.lu, alpha, &lam)
+                    {
+                        let w = this.problem.delassus().w();
+                        let wl = mat_mul(w, &[&refined[..]]).pop().expect("one column");
+                        let lo = this.load.general_q_lo().map(|(_, lo)| lo.to_vec());
+                        let lo = lo.unwrap_or_else(|| vec![0.0; wl.len()]);
+                        d = (0..wl.len()).map(|i| (qg[i] + lo[i]) + wl[i]).collect();
+                        lam = refined;
+                    }
+                    [lam, d, t, rate]
+                }
             };
             t.push(1.0);
             let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
@@ -560,13 +577,24 @@ impl Path {
             // A guard positive at both ends with a minimum inside (its derivative changes
             // sign) may dip below zero and come back: locate the minimum (Brent on the
             // derivative) and look at the guard there. A double crossing inside one step
-            // is never skipped, however close to tangent.
+            // is never skipped, however close to tangent. Not where both slopes would
+            // change the guard by less than 1e-9 of its smaller end value over the step
+            // (slopes at rounding level, as on the open nodes of a slender body, where
+            // each such search cost tens of evaluations): a dip to zero would then need a
+            // load stationary at both ends and varying a billion times faster inside,
+            // which the midpoint test below looks for as for every guard.
             let mut cut: Option<f64> = None;
+            let delta_b = pb.alpha - pa.alpha;
             for k in 0..gb.len() {
+                let flat = 1e-9 * ga[k].value.min(gb[k].value);
                 if ga[k].value > -tol[k]
                     && gb[k].value >= -tol[k]
                     && dir * ga[k].slope < 0.0
                     && dir * gb[k].slope > 0.0
+                    && (ga[k].slope * delta_b)
+                        .abs()
+                        .max((gb[k].slope * delta_b).abs())
+                        >= flat
                 {
                     let smin = brent_fallible(
                         pa.alpha,

@@ -292,10 +292,13 @@ impl Path {
                 None => (vec![0.0; m], vec![0.0; m]),
             };
             vec![(q0, q0_lo), (q1, q1_lo)]
-        } else {
-            let qs = self.load.basis_vectors()?;
+        } else if let Some(qs) = self.load.basis_vectors() {
             let lo = self.load.q_lo()?;
             qs.iter().cloned().zip(lo.iter().cloned()).collect()
+        } else {
+            // A general load: q at the α of its last evaluation, the one basis vector.
+            let (q, lo) = self.load.general_q_lo()?;
+            vec![(q.to_vec(), lo.to_vec())]
         };
         let w = del.w();
         let row_bound = self.row_bound();
@@ -385,13 +388,17 @@ impl Path {
         lam: &[f64],
     ) -> Option<Vec<f64>> {
         let problem = self.problem.clone();
+        if !self.load.is_affine() {
+            // A basis load's weights at α, a general load's q(α) (the refiner's).
+            self.load.q(alpha, problem.delassus()).ok()?;
+        }
         let r = self.refiner(&problem, classes, lu)?;
         let c = if self.load.is_affine() {
             r.point_constant(alpha)
-        } else {
-            // A basis load: its weights at α.
-            self.load.q(alpha, problem.delassus()).ok()?;
+        } else if self.load.basis_vectors().is_some() {
             r.basis_constant(self.load.weights_at(alpha)?.0, true)
+        } else {
+            r.basis_constant(&[1.0], true)
         };
         let (x, _) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
         let out: Vec<f64> = (0..x.hi.len()).map(|k| x.get(k).to_f64()).collect();
