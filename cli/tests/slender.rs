@@ -390,6 +390,18 @@ fn strip_p240_basis_loads() {
     c.check(1e-10)
         .expect("the affine load against the reference");
     let want = ref_events(&c.reference);
+    // A trace to the window's end whose events at s_k = φ(α_k) are the reference's
+    // (φ(α_end) = α_end to rounding: the window ends where the reference's does).
+    let check = |path: &fricont::Path, phi: &dyn Fn(f64) -> f64, tol: f64, ctx: &str| {
+        assert_eq!(path.end_reason().map(|r| r.name()), Some("window"), "{ctx}");
+        let got: Vec<Ev> = path
+            .events()
+            .iter()
+            .map(|e| (phi(e.alpha), e.node, e.from, e.to))
+            .collect();
+        let worst = compare_events(&got, &want, tol).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+        eprintln!("{ctx}: {} events, worst {worst:e}", got.len());
+    };
     let len = a1 - a0;
     let (amp, omega) = (len / 100.0, 2.0 * std::f64::consts::PI * 10.0 / len);
     // Extended precision (auto: on here), and double alone (W not refined either).
@@ -420,15 +432,7 @@ fn strip_p240_basis_loads() {
             let mut path = fricont::Path::new(problem.clone(), load, opts).expect("path");
             path.start(a0, None).expect(&ctx);
             path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
-            assert_eq!(path.end_reason().map(|r| r.name()), Some("window"), "{ctx}");
-            let got: Vec<Ev> = path
-                .events()
-                .iter()
-                .map(|e| (phi(e.alpha), e.node, e.from, e.to))
-                .collect();
-            // φ(α_end) = α_end to rounding: the window ends where the reference's does.
-            let worst = compare_events(&got, &want, tol).unwrap_or_else(|e| panic!("{ctx}: {e}"));
-            eprintln!("{ctx}: {} events, worst {worst:e}", got.len());
+            check(&path, &phi, tol, &ctx);
         }
     }
     // The same loads as general loads, f(α) itself, solved afresh at each α. In double
@@ -460,17 +464,7 @@ fn strip_p240_basis_loads() {
                     eprintln!("{ctx}: stopped loudly after {}: {msg}", path.events().len());
                 }
                 Err(e) => panic!("{ctx}: {e}"),
-                Ok(_) => {
-                    assert_eq!(path.end_reason().map(|r| r.name()), Some("window"), "{ctx}");
-                    let got: Vec<Ev> = path
-                        .events()
-                        .iter()
-                        .map(|e| (phi(e.alpha), e.node, e.from, e.to))
-                        .collect();
-                    let worst = compare_events(&got, &want, tol.unwrap_or(5e-7))
-                        .unwrap_or_else(|e| panic!("{ctx}: {e}"));
-                    eprintln!("{ctx}: {} events, worst {worst:e}", got.len());
-                }
+                Ok(_) => check(&path, &phi, tol.unwrap_or(5e-7), &ctx),
             }
         }
     }
