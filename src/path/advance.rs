@@ -4,7 +4,7 @@
 
 use super::roots::{brent_fallible, hermite_min, newton_bracketed};
 use super::*;
-use crate::dense::{axpy, mat_mul};
+use crate::dense::axpy;
 
 /// A guard with its value and its derivative along the tangent.
 pub(super) struct GuardRow {
@@ -506,12 +506,7 @@ impl Path {
                     if basis.is_none()
                         && let Some(refined) = this.polish_point(&classes, &cur.lu, alpha, &lam)
                     {
-                        let w = this.problem.delassus().w();
-                        let wl = mat_mul(w, &[&refined[..]]).pop().expect("one column");
-                        let lo = this.load.general_q_lo().map(|(_, lo)| lo.to_vec());
-                        let lo = lo.unwrap_or_else(|| vec![0.0; wl.len()]);
-                        d = (0..wl.len()).map(|i| (qg[i] + lo[i]) + wl[i]).collect();
-                        lam = refined;
+                        (lam, d) = refined;
                     }
                     [lam, d, t, rate]
                 }

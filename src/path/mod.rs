@@ -53,11 +53,11 @@ pub struct PathOptions {
     /// Largest α step of the step control of a basis or general (nonlinear) load (α
     /// units; default `None`: 1/8 of the window's length). Each step is also shortened
     /// until the cubic Hermite model of every guard predicts a fresh evaluation at the
-    /// step's midpoint, value and slope; a load that varies faster than that test can see (an excursion of
-    /// a guard below zero and back, narrower than the step at which the test passes) is
-    /// caught only by a step no longer than the excursion: set this to a fraction of the
-    /// shortest period or feature of a load that oscillates. No effect on affine loads,
-    /// whose pieces are followed exactly. Must be finite and > 0.
+    /// step's midpoint, value and slope; a load that varies faster than that test can
+    /// see (an excursion of a guard below zero and back, narrower than the step at which
+    /// the test passes) is caught only by a step no longer than the excursion: set this
+    /// to a fraction of the shortest period or feature of a load that oscillates. No
+    /// effect on affine loads, whose pieces are followed exactly. Must be finite and > 0.
     pub max_alpha_step: Option<f64>,
 }
 
@@ -1260,7 +1260,7 @@ impl Path {
         // On a graph piece of a problem carried beyond double, the start point too is
         // refined in double-double (from the fixed-α solve's point).
         if !cand.scales.is_vertical(&cand.t)
-            && let Some(lam) = self.polish_point(&cand.classes, &cand.lu, alpha, &pt.lam)
+            && let Some((lam, _)) = self.polish_point(&cand.classes, &cand.lu, alpha, &pt.lam)
         {
             pt.lam = lam;
         }

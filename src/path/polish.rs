@@ -377,16 +377,17 @@ impl Path {
     }
 
     /// λ on the graph piece `classes` (solved by `lu`) at α, refined in double-double
-    /// from the guess `lam` and rounded: the start point. None as for [`Self::refiner`],
-    /// when the refinement does not converge, or when it lands farther from `lam` than
-    /// [`near`] allows.
+    /// from the guess `lam` and rounded, with its `d = W λ + q(α) − (g, 0)` (from the
+    /// double-double one): the start point, and each point of a general load's march.
+    /// None as for [`Self::refiner`], when the refinement does not converge, or when it
+    /// lands farther from `lam` than [`near`] allows.
     pub(super) fn polish_point(
         &mut self,
         classes: &[Class],
         lu: &PieceSolver,
         alpha: f64,
         lam: &[f64],
-    ) -> Option<Vec<f64>> {
+    ) -> Option<(Vec<f64>, Vec<f64>)> {
         let problem = self.problem.clone();
         if !self.load.is_affine() {
             // A basis load's weights at α, a general load's q(α) (the refiner's).
@@ -400,9 +401,11 @@ impl Path {
         } else {
             r.basis_constant(&[1.0], true)
         };
-        let (x, _) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
+        let (x, d) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
         let out: Vec<f64> = (0..x.hi.len()).map(|k| x.get(k).to_f64()).collect();
-        (out.iter().all(|v| v.is_finite()) && near(&out, lam)).then_some(out)
+        let d: Vec<f64> = (0..d.hi.len()).map(|k| d.get(k).to_f64()).collect();
+        let finite = out.iter().chain(&d).all(|v| v.is_finite());
+        (finite && near(&out, lam)).then_some((out, d))
     }
 
     /// The straight piece `cur` (affine load, α moving) refined in double-double: its
