@@ -6,6 +6,22 @@ use super::roots::{brent_fallible, hermite_min, newton_bracketed};
 use super::*;
 use crate::dense::axpy;
 
+/// True where a guard `k` not `skip`ped dips below its threshold `−tol[k]` on a stretch
+/// of α of length `len` (signed) whose ends have the rows `a` and `b`: in the cubic
+/// Hermite model of its values and slopes there, the ends included.
+fn dips(
+    a: &[GuardRow],
+    b: &[GuardRow],
+    len: f64,
+    tol: &[f64],
+    skip: impl Fn(usize) -> bool,
+) -> bool {
+    (0..b.len()).any(|k| {
+        let (m0, m1) = (a[k].slope * len, b[k].slope * len);
+        !skip(k) && hermite_min(a[k].value, b[k].value, m0, m1) < -tol[k]
+    })
+}
+
 /// A guard with its value and its derivative along the tangent.
 pub(super) struct GuardRow {
     pub(super) guard: Guard,
@@ -648,15 +664,7 @@ impl Path {
                 .collect();
             if crossing.is_empty() {
                 // Hermite check for a dip below zero inside the step
-                let dip = (0..gb.len()).any(|k| {
-                    if below[k] {
-                        return false;
-                    }
-                    let (v0, v1) = (ga[k].value, gb[k].value);
-                    let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
-                    hermite_min(v0, v1, m0, m1) < -tol[k]
-                });
-                if dip && h > hmin {
+                if dips(&ga, &gb, delta, &tol, |k| below[k]) && h > hmin {
                     h *= 0.5;
                     continue;
                 }
@@ -730,14 +738,8 @@ impl Path {
             // in its cubic Hermite model on [α_a, root] (the models were trusted on the
             // whole step). Else the step is shortened to the first half of that stretch.
             let stretch = root - pa.alpha;
-            let dips = (0..tab.len()).any(|k| {
-                if below[k] || tab[k].guard == g {
-                    return false;
-                }
-                let (m0, m1) = (ga[k].slope * stretch, tab[k].slope * stretch);
-                tab[k].value < -tol[k] || hermite_min(ga[k].value, tab[k].value, m0, m1) < -tol[k]
-            });
-            if dips && h > hmin && stretch != 0.0 {
+            let dip = dips(&ga, &tab, stretch, &tol, |k| below[k] || tab[k].guard == g);
+            if dip && h > hmin && stretch != 0.0 {
                 h = 0.5 * stretch.abs();
                 continue;
             }
