@@ -1265,11 +1265,11 @@ fricont_status fricont_path_set_zero_tol(struct fricont_path *path,
  * the window's length; must be finite and > 0. Only before the first start.
  *
  * Each step is also shortened until the cubic Hermite model of every guard predicts a
- * fresh evaluation at the step's midpoint, value and slope. A load that varies faster than that test can
- * see (a guard that dips below zero and comes back within a stretch narrower than the
- * step at which the test passes) is caught only by a step no longer than that stretch:
- * for an oscillating load, set this to a fraction of its shortest period. No effect on an
- * affine load, whose pieces are followed exactly.
+ * fresh evaluation at the step's midpoint, value and slope. A load that varies faster
+ * than that test can see (a guard that dips below zero and comes back within a stretch
+ * narrower than the step at which the test passes) is caught only by a step no longer
+ * than that stretch: for an oscillating load, set this to a fraction of its shortest
+ * period. No effect on an affine load, whose pieces are followed exactly.
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (not finite or ≤ 0),
  * `FRICONT_ERR_ORDER` (after the first start), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
