@@ -133,6 +133,70 @@ fn one_node_sine_loads_at_many_phases_frequencies_and_directions() {
     assert!(cases >= 150, "only {cases} cases");
 }
 
+/// Loads whose period divides the march's first step: the cases of a random scan (3000
+/// one-node sines per seed) where a first step of span/32 spanned two whole periods,
+/// starting near a peak of the guard, so that its midpoint (a whole period in) agreed
+/// with the model from the ends in value and nearly in slope, and the excursions of the
+/// first periods were skipped (8 to 20 roots each), and one made so on purpose.
+#[test]
+fn loads_with_periods_dividing_the_first_step_lose_no_excursion() {
+    let span = 6.0;
+    let omega = 2.0 * PI * 64.0 / span; // span/32 is two periods
+    let cases = [
+        (
+            0.31678089385249214,
+            73.99046340197118,
+            5.748431089800185,
+            -1.49874225850236,
+            -6.9660747451580685,
+        ),
+        (
+            0.68977177164903,
+            96.28808334746007,
+            3.7881837902635493,
+            -0.2200655926670101,
+            3.986777683037896,
+        ),
+        (
+            0.9341313183508408,
+            67.94694152818262,
+            3.4675096973587367,
+            -0.027452766974642273,
+            -5.959651686182518,
+        ),
+        (
+            0.3546877687505156,
+            73.81193687859387,
+            1.510572494327531,
+            -1.4477829113840561,
+            4.088107545000279,
+        ),
+        // the guard at its peak at the start
+        (
+            0.9,
+            omega,
+            (PI / 2.0 + omega).rem_euclid(2.0 * PI),
+            -1.0,
+            -1.0 + span,
+        ),
+    ];
+    for (k, &(c0, om, phase, a0, a1)) in cases.iter().enumerate() {
+        let want = roots(c0, om, phase, a0, a1);
+        let got = trace_one_node((c0, om, phase), (a0, a1), k % 2 == 0);
+        let case = format!("c0 {c0} ω {om} φ {phase} window ({a0}, {a1})");
+        assert_eq!(got.len(), want.len(), "{case}: events {got:?}");
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (g.0 - w.0).abs() <= 1e-9,
+                "{case}: α {} expected {}",
+                g.0,
+                w.0
+            );
+            assert_eq!((g.1, g.2), (w.1, w.2), "{case}: at α = {}", w.0);
+        }
+    }
+}
+
 /// A finite-element mesh under `f(α) = f0 + A sin(50 α) f1` over three periods: every
 /// transition point of the affine path with |φ| < A is met six times (up and down in each
 /// period), at the α where A sin(50 α) equals it. Reference: the same mesh traced under

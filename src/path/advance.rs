@@ -536,10 +536,16 @@ impl Path {
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
+        // The first piece's march starts short and doubles its way up: a step trusted by
+        // its midpoint can alias the load's period only when it spans whole periods, and
+        // one reached by doubling a trusted step cannot (its half was trusted). A first
+        // step of span/32 spanned two periods of a load with 64 periods on the window,
+        // and its excursions there were skipped.
+        let floor = span / 1024.0;
         let first = self
             .graph_step
             .get()
-            .map_or(span / 32.0, |h| (2.0 * h).max(span / 1024.0));
+            .map_or(floor, |h| (2.0 * h).max(floor));
         let mut h = first
             .min(span / 32.0)
             .min(hmax)

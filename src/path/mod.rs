@@ -1149,6 +1149,7 @@ impl Path {
         // A path's numbers depend on its own history only: no factorisation from an
         // earlier start is reused.
         *self.updater.borrow_mut() = None;
+        self.graph_step.set(None);
         let (lo, hi) = self.window();
         if !(alpha >= lo && alpha <= hi) {
             return Err(Error::InvalidParameter(format!(
