@@ -100,22 +100,30 @@ impl Path {
             return None;
         };
         let qs = self.load.basis_vectors()?;
-        let c = self.consts();
-        let zeros = vec![0.0; 2 * c.p];
-        let mut rhs: Vec<Vec<f64>> = qs.iter().map(|q| c.piece_rhs(&cur.classes, q)).collect();
-        let g = shift_gap(&zeros, self.problem.gap_equilibrated());
-        rhs.push(c.piece_rhs(&cur.classes, &g));
-        let cols: Vec<update::Rhs<'_>> =
-            rhs.iter().map(|b| update::Rhs { b, guess: None }).collect();
-        let solved = u.solve_checked_many(&c, self.problem.delassus().w(), &cols, self.row_bound());
-        if solved
-            .iter()
-            .any(|s| s.rel > 1e-12 || !s.x.iter().all(|v| v.is_finite()))
-        {
-            return None;
-        }
-        let (y, wy): (Vec<Vec<f64>>, Vec<Vec<f64>>) =
-            solved.into_iter().map(|s| (s.x, s.wx)).unzip();
+        // Carried by the updates to this piece and checked from the data when its tangent
+        // was computed (Path::tangent_updated): nothing to solve.
+        let (y, wy) = match u.checked().filter(|k| k.0.len() == qs.len() + 1) {
+            Some(k) => Arc::unwrap_or_clone(k),
+            None => {
+                let c = self.consts();
+                let zeros = vec![0.0; 2 * c.p];
+                let mut rhs: Vec<Vec<f64>> =
+                    qs.iter().map(|q| c.piece_rhs(&cur.classes, q)).collect();
+                let g = shift_gap(&zeros, self.problem.gap_equilibrated());
+                rhs.push(c.piece_rhs(&cur.classes, &g));
+                let cols: Vec<update::Rhs<'_>> =
+                    rhs.iter().map(|b| update::Rhs { b, guess: None }).collect();
+                let w = self.problem.delassus().w();
+                let solved = u.solve_checked_many(&c, w, &cols, self.row_bound());
+                if solved
+                    .iter()
+                    .any(|s| s.rel > 1e-12 || !s.x.iter().all(|v| v.is_finite()))
+                {
+                    return None;
+                }
+                solved.into_iter().map(|s| (s.x, s.wx)).unzip()
+            }
+        };
         Some(match self.refine_basis(cur, &y) {
             Some(r) => {
                 let (y, wy) = r.into_iter().unzip();
@@ -532,7 +540,17 @@ impl Path {
             if exact {
                 this.prime_gaps(alpha, &lam, d);
             }
-            Ok((Point { lam, alpha, q, dq }, table))
+            let dw = this.load.weights_at(alpha).map(|(_, dw)| dw.to_vec());
+            Ok((
+                Point {
+                    lam,
+                    alpha,
+                    q,
+                    dq,
+                    dw,
+                },
+                table,
+            ))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
@@ -791,6 +809,7 @@ impl Path {
                             alpha: x,
                             q,
                             dq,
+                            dw: Some(dw.to_vec()),
                         },
                         table,
                     ))

@@ -449,6 +449,8 @@ struct Point {
     alpha: f64,
     q: Vec<f64>,
     dq: Vec<f64>,
+    /// A basis load's weight derivatives `w'(α)` (`dq = Σ_j w'_j q_j`); None otherwise.
+    dw: Option<Vec<f64>>,
 }
 
 #[derive(Clone)]
@@ -677,7 +679,14 @@ impl Path {
 
     fn point_at(&mut self, lam: Vec<f64>, alpha: f64) -> Result<Point> {
         let (q, dq) = self.load.q(alpha, self.problem.delassus())?;
-        Ok(Point { lam, alpha, q, dq })
+        let dw = self.load.weights_at(alpha).map(|(_, dw)| dw.to_vec());
+        Ok(Point {
+            lam,
+            alpha,
+            q,
+            dq,
+            dw,
+        })
     }
 
     /// Force scale of a point: `max(‖λ‖∞, r0 T, r0 max_i (q − g)ν_i⁺)` with T the
@@ -962,31 +971,147 @@ impl Path {
         let d = self.gaps(pt);
         let zeros = vec![0.0; m];
         let resid = update::residual_rows(&c, classes, &pt.lam, &d, &zeros);
+        // The right-hand sides carried from piece to piece by the rank-2 updates (O(km),
+        // see update::Carried): an affine load's α column (the tangent itself); a basis
+        // load's columns rhs_S(q_j) and the gap's, from which the tangent is combined
+        // (λ' = Σ_j w'_j y_j) and which the march on the piece reuses
+        // (advance::BasisSolutions) instead of solving for them. None for a general load,
+        // whose α column changes with α.
+        let basis_dw = pt
+            .dw
+            .as_deref()
+            .zip(self.load.basis_vectors())
+            .filter(|(dw, qs)| dw.len() == qs.len());
+        let targets: Option<Vec<Vec<f64>>> = if self.load.is_affine() {
+            Some(vec![neg.clone()])
+        } else {
+            basis_dw.map(|(_, qs)| {
+                let g = shift_gap(&zeros, self.problem.gap_equilibrated());
+                qs.iter()
+                    .chain(std::iter::once(&g))
+                    .map(|q| c.piece_rhs(classes, q))
+                    .collect()
+            })
+        };
+        let add =
+            |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| x + y).collect() };
+        // Solutions of the carried columns checked from the data: each kept where its
+        // residual is at rounding level, else solved for from it (as a correction).
+        let check_cols = |u: &UpdatedLu,
+                          mut ys: Vec<Vec<f64>>,
+                          mut wys: Vec<Vec<f64>>,
+                          bs: &[Vec<f64>]|
+         -> Option<update::CheckedCols> {
+            let rs: Vec<(Vec<f64>, f64)> = (0..bs.len())
+                .map(|j| {
+                    let r = update::residual_rows(&c, classes, &ys[j], &wys[j], &bs[j]);
+                    let rel = update::relative_residual(&c, classes, &r, &ys[j], &bs[j], rb);
+                    (r, rel)
+                })
+                .collect();
+            let again: Vec<usize> = (0..bs.len())
+                .filter(|&j| rs[j].1.is_nan() || rs[j].1 > update::REFINE_ABOVE)
+                .collect();
+            if !again.is_empty() {
+                let solved = {
+                    let cols: Vec<update::Rhs<'_>> = again
+                        .iter()
+                        .map(|&j| update::Rhs {
+                            b: &bs[j],
+                            guess: Some((&ys[j], &rs[j].0)),
+                        })
+                        .collect();
+                    u.solve_checked_many(&c, w, &cols, rb)
+                };
+                for (&j, k) in again.iter().zip(solved) {
+                    if k.rel > 1e-12 {
+                        return None;
+                    }
+                    // For a guess, wx is W times the correction only.
+                    wys[j] = add(&wys[j], &k.wx);
+                    ys[j] = k.x;
+                }
+            }
+            ys.iter()
+                .all(|y| y.iter().all(|v| v.is_finite()))
+                .then_some((ys, wys))
+        };
+        // The tangent y (M_S y = −∂H/∂α) with W y: from the checked columns (an affine
+        // load's α column, a basis load's combination) where its residual from the data is
+        // at rounding level, else solved for (from that residual, as a correction).
+        let tangent_of = |u: &UpdatedLu, cols: Option<&update::CheckedCols>| {
+            // An affine load's column is the tangent's, checked already.
+            if let (None, Some((ys, wys))) = (basis_dw, cols) {
+                return Some((ys[0].clone(), wys[0].clone()));
+            }
+            let guess = cols.zip(basis_dw).map(|((ys, wys), (dw, _))| {
+                let (mut y, mut wy) = (vec![0.0; m], vec![0.0; m]);
+                for (j, &f) in dw.iter().enumerate() {
+                    crate::dense::axpy(&mut y, f, &ys[j]);
+                    crate::dense::axpy(&mut wy, f, &wys[j]);
+                }
+                let r = update::residual_rows(&c, classes, &y, &wy, &neg);
+                let rel = update::relative_residual(&c, classes, &r, &y, &neg, rb);
+                (y, wy, r, rel)
+            });
+            if let Some(g) = guess.as_ref().filter(|g| g.3 <= update::REFINE_ABOVE) {
+                return Some((g.0.clone(), g.1.clone()));
+            }
+            let col = update::Rhs {
+                b: &neg,
+                guess: guess.as_ref().map(|g| (&g.0[..], &g.2[..])),
+            };
+            let k = u
+                .solve_checked_many(&c, w, &[col], rb)
+                .pop()
+                .filter(|k| k.rel <= 1e-12)?;
+            let wy = match &guess {
+                Some(g) => add(&g.1, &k.wx),
+                None => k.wx,
+            };
+            Some((k.x, wy))
+        };
+        // Keeps the checked columns with the factorisation: a basis load's piece reuses
+        // them (a fresh carry first where there was none).
+        let keep = |u: &mut UpdatedLu, cols: update::CheckedCols, fresh_carry: bool| {
+            if let Some(bs) = &targets {
+                if fresh_carry {
+                    u.set_carry(&c, bs, &cols.0);
+                }
+                if basis_dw.is_some() {
+                    u.set_checked(cols);
+                }
+            }
+        };
         // On an update of the current base, the point is the current λ corrected from
         // its residual on this piece's equations (O(m) with the point's d): on a
         // neighbouring piece that residual is at rounding level, and so is the
         // correction's error; its solve shares the pass over the base's factor with the
-        // new nodes' columns. The tangent needs no solve when the solution carried from
-        // the previous piece by the rank-2 updates (O(km), see update::Carried) has a
-        // residual from the data at rounding level; otherwise it is solved for (from that
-        // residual, as a correction).
+        // new nodes' columns.
         let extended = self
             .updater
             .borrow()
             .as_ref()
             .filter(|u| u.reaches(classes))
-            .and_then(|u| u.extend(&c, w, classes, Some(&neg), std::slice::from_ref(&resid)));
+            .and_then(|u| {
+                u.extend(
+                    &c,
+                    w,
+                    classes,
+                    targets.as_deref(),
+                    std::slice::from_ref(&resid),
+                )
+            });
         let on_update = |(mut u, dx): (UpdatedLu, Vec<Vec<f64>>)| {
-            // W times the point's correction and the carried tangent: one pass over W.
+            // W times the point's correction and the carried columns: one pass over W.
             let carried = u.carried();
             let mut cols: Vec<&[f64]> = vec![&dx[0]];
-            cols.extend(carried.as_deref());
+            if let Some(cs) = &carried {
+                cols.extend(cs.iter().map(|v| &v[..]));
+            }
             let mut prods = crate::dense::mat_mul(w, &cols).into_iter();
             // The point and its residual from the data; refined once when that is above
             // rounding level, and then it must be small.
-            let add = |a: &[f64], b: &[f64]| -> Vec<f64> {
-                a.iter().zip(b).map(|(x, y)| x + y).collect()
-            };
             let mut xp = add(&pt.lam, &dx[0]);
             let mut dp = add(&d, &prods.next()?);
             let mut r = update::residual_rows(&c, classes, &xp, &dp, &zeros);
@@ -1004,56 +1129,46 @@ impl Path {
             }
             // d at the piece's point, for the ratio test that starts there.
             self.prime_gaps(pt.alpha, &xp, dp);
-            // The tangent: the carried solution where its residual from the data is at
-            // rounding level, else solved for (from that residual, as a correction).
-            let carried = carried.map(|y| {
-                let wy = prods.next().expect("a product per column");
-                let r = update::residual_rows(&c, classes, &y, &wy, &neg);
-                let rel = update::relative_residual(&c, classes, &r, &y, &neg, rb);
-                (y, wy, r, rel)
-            });
-            let (y, wy) = match carried.as_ref().filter(|k| k.3 <= update::REFINE_ABOVE) {
-                Some(k) => (k.0.clone(), k.1.clone()),
-                None => {
-                    let col = update::Rhs {
-                        b: &neg,
-                        guess: carried.as_ref().map(|k| (&k.0[..], &k.2[..])),
-                    };
-                    let y = u
-                        .solve_checked_many(&c, w, &[col], rb)
-                        .pop()
-                        .filter(|y| y.rel <= 1e-12)?;
-                    // For a carried guess, wx is W times the correction only.
-                    let wy = match &carried {
-                        Some(k) => add(&k.1, &y.wx),
-                        None => y.wx,
-                    };
-                    (y.x, wy)
+            // The carried columns (or, where nothing was carried, solved for afresh).
+            let fresh_carry = carried.is_none();
+            let checked = match (&targets, carried) {
+                (Some(bs), Some(ys)) => {
+                    let wys: Vec<Vec<f64>> = prods.collect();
+                    check_cols(&u, ys, wys, bs)
                 }
+                (Some(bs), None) => {
+                    let cols: Vec<update::Rhs<'_>> =
+                        bs.iter().map(|b| update::Rhs { b, guess: None }).collect();
+                    let ks = u.solve_checked_many(&c, w, &cols, rb);
+                    ks.iter()
+                        .all(|k| k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()))
+                        .then(|| ks.into_iter().map(|k| (k.x, k.wx)).unzip())
+                }
+                _ => None,
             };
-            // Only an affine load's α column stays put from piece to piece: elsewhere a
-            // carry would cost a base solve here and be dropped at the next update.
-            if carried.is_none() && self.load.is_affine() {
-                u.set_carry(&c, &neg, &y);
+            let (y, wy) = tangent_of(&u, checked.as_ref())?;
+            if let Some(cols) = checked {
+                keep(&mut u, cols, fresh_carry);
             }
             Some((u, (y, wy, xp)))
         };
-        // A fresh base: the tangent and the point in one checked solve.
+        // A fresh base: the carried columns (or the tangent's) and the point in one
+        // checked solve.
         let on_fresh = |u: &mut UpdatedLu| {
-            let cols = [
-                update::Rhs {
+            let mut cols: Vec<update::Rhs<'_>> = match &targets {
+                Some(bs) => bs.iter().map(|b| update::Rhs { b, guess: None }).collect(),
+                None => vec![update::Rhs {
                     b: &neg,
                     guess: None,
-                },
-                update::Rhs {
-                    b: &rhs,
-                    guess: Some((&pt.lam, &resid)),
-                },
-            ];
+                }],
+            };
+            cols.push(update::Rhs {
+                b: &rhs,
+                guess: Some((&pt.lam, &resid)),
+            });
             let mut ch = u.solve_checked_many(&c, w, &cols, rb);
-            let xp = ch.pop().expect("two columns");
-            let y = ch.pop().expect("two columns");
-            if y.rel > 1e-12 || xp.rel > 1e-12 {
+            let xp = ch.pop().expect("the point's column");
+            if xp.rel > 1e-12 || ch.iter().any(|k| k.rel > 1e-12) {
                 return None;
             }
             self.prime_gaps(
@@ -1061,8 +1176,15 @@ impl Path {
                 &xp.x,
                 d.iter().zip(&xp.wx).map(|(a, b)| a + b).collect(),
             );
-            u.set_carry(&c, &neg, &y.x);
-            Some((y.x, y.wx, xp.x))
+            let cols: update::CheckedCols = ch.into_iter().map(|k| (k.x, k.wx)).unzip();
+            let (y, wy) = if targets.is_some() {
+                let yw = tangent_of(u, Some(&cols))?;
+                keep(u, cols, true);
+                yw
+            } else {
+                (cols.0[0].clone(), cols.1[0].clone())
+            };
+            Some((y, wy, xp.x))
         };
         let (upd, (y, wy, xp), fresh) = match extended.and_then(on_update) {
             Some((u, y)) => (u, y, false),

@@ -116,21 +116,29 @@ struct Update {
     z: Arc<NodeCols>,
 }
 
-/// The base's solution `x0 = (D M_0)⁻¹ b` of a right-hand side b carried from piece to
-/// piece: when the class of node i changes, `b` changes in rows i, p+i only (the α column
-/// of an affine load, whose q' is constant), so `x0` changes by the base's columns of node
-/// i times that change (O(m), no pass over the base's factor), and the piece's solution is
+/// The base's solutions `x0 = (D M_0)⁻¹ b` of right-hand sides b carried from piece to
+/// piece: when the class of node i changes, each `b` changes in rows i, p+i only (the α
+/// column of an affine load, whose q' is constant; the columns `rhs_S(q_j)` of a basis
+/// load's vectors and of the gap), so `x0` changes by the base's columns of node i times
+/// that change (O(m), no pass over the base's factor), and the piece's solution is
 /// `x0 − Z C⁻¹ V x0` (O(km)): what a fresh solve with the updated factorisation gives, up
-/// to the rounding of those sums. The caller checks it by its residual from the data.
+/// to the rounding of those sums. The caller checks them by their residuals from the data.
 #[derive(Clone)]
 pub(crate) struct Carried {
-    /// The right-hand side, in `r0` units.
-    b: Vec<f64>,
-    /// The base's solution of it (λ units).
-    x0: Vec<f64>,
-    /// The piece's solution of it, where it was computed ([`UpdatedLu::extend`]).
-    y: Option<Vec<f64>>,
+    /// The right-hand sides, in `r0` units.
+    b: Vec<Vec<f64>>,
+    /// The base's solutions of them (λ units).
+    x0: Vec<Vec<f64>>,
+    /// The piece's solutions, where they were computed ([`UpdatedLu::extend`]).
+    y: Option<Vec<Vec<f64>>>,
+    /// The piece's solutions as the caller checked them from the data (or solved them
+    /// again), with W times each ([`UpdatedLu::set_checked`]).
+    checked: Option<Arc<CheckedCols>>,
 }
+
+/// Solutions of the carried right-hand sides on one piece, checked from the data: the
+/// solutions, and W times each.
+pub(crate) type CheckedCols = (Vec<Vec<f64>>, Vec<Vec<f64>>);
 
 /// `M_S` for one class vector, as a base plus updates. Cheap to clone (the big arrays are
 /// shared).
@@ -236,9 +244,9 @@ impl UpdatedLu {
 
     /// The factorisation for `classes`, by one rank-2 update per node whose class differs.
     /// `None` when an update makes C singular (then `M_S` is singular). With `carry_to`
-    /// (the right-hand side b of `M_S y = b` for `classes`, the seed's row scaling), a
-    /// solution carried by `self` is carried along (see [`Carried`]); it is dropped when
-    /// it does not end up solving for exactly that b. Each column of `extra` (the seed's
+    /// (the right-hand sides b of `M_S y = b` for `classes`, the seed's row scaling), the
+    /// solutions carried by `self` are carried along (see [`Carried`]); they are dropped
+    /// when they do not end up solving for exactly those b. Each column of `extra` (the seed's
     /// row scaling for `classes`) is solved for with the new piece matrix, without a
     /// check, its pass over the base's factor shared with the new nodes' columns.
     pub fn extend(
@@ -246,11 +254,12 @@ impl UpdatedLu {
         c: &PieceConstants<'_>,
         w: MatRef<'_, f64>,
         classes: &[Class],
-        carry_to: Option<&[f64]>,
+        carry_to: Option<&[Vec<f64>]>,
         extra: &[Vec<f64>],
     ) -> Option<(Self, Vec<Vec<f64>>)> {
         let mut out = self.clone();
-        let target = carry_to.map(|b| scale_rhs(c, classes, b));
+        let target: Option<Vec<Vec<f64>>> =
+            carry_to.map(|bs| bs.iter().map(|b| scale_rhs(c, classes, b)).collect());
         if target.is_none() {
             out.carry = None;
         }
@@ -267,36 +276,60 @@ impl UpdatedLu {
         {
             out.carry = None;
         }
-        // The extras and the carried solution, corrected together.
+        // The extras and the carried solutions, corrected together.
         let mut cols = x0;
         let n_extra = cols.len();
         if let Some(cr) = &out.carry {
-            cols.push(cr.x0.clone());
+            cols.extend(cr.x0.iter().cloned());
         }
         let mut xs = out.correct_many(cols);
         if xs.len() > n_extra
             && let Some(cr) = out.carry.take()
         {
-            let y = xs.pop();
+            let y = xs.split_off(n_extra);
             out.carry = Some(Arc::new(Carried {
-                y,
+                y: Some(y),
+                checked: None,
                 ..Arc::unwrap_or_clone(cr)
             }));
         }
         Some((out, xs))
     }
 
-    /// Keeps the right-hand side b (the seed's row scaling) of `M_S y = b`, solved by
-    /// `y`, to be carried to the next pieces (see [`Carried`]).
-    pub fn set_carry(&mut self, c: &PieceConstants<'_>, b: &[f64], y: &[f64]) {
-        // On the base itself x0 is y; on an update, one solve with the base.
-        let b = scale_rhs(c, &self.classes, b);
+    /// Keeps the right-hand sides `bs` (the seed's row scaling) of `M_S y = b`, solved by
+    /// `ys`, to be carried to the next pieces (see [`Carried`]).
+    pub fn set_carry(&mut self, c: &PieceConstants<'_>, bs: &[Vec<f64>], ys: &[Vec<f64>]) {
+        // On the base itself x0 is y; on an update, one pass over the base's factor.
+        let b: Vec<Vec<f64>> = bs.iter().map(|b| scale_rhs(c, &self.classes, b)).collect();
         let x0 = if self.updates.is_empty() {
-            y.to_vec()
+            ys.to_vec()
         } else {
             self.base_solve(&b)
         };
-        self.carry = Some(Arc::new(Carried { b, x0, y: None }));
+        self.carry = Some(Arc::new(Carried {
+            b,
+            x0,
+            y: None,
+            checked: None,
+        }));
+    }
+
+    /// Keeps the carried right-hand sides' solutions on this piece as the caller checked
+    /// them from the data, with W times each (see [`Self::checked`]). No-op without a
+    /// carry or with a different number of columns.
+    pub fn set_checked(&mut self, cols: CheckedCols) {
+        if let Some(cr) = self.carry.take() {
+            let n = cr.b.len();
+            let mut cr = Arc::unwrap_or_clone(cr);
+            cr.checked = (cols.0.len() == n && cols.1.len() == n).then(|| Arc::new(cols));
+            self.carry = Some(Arc::new(cr));
+        }
+    }
+
+    /// The carried right-hand sides' solutions kept by [`Self::set_checked`] on this very
+    /// piece (an update drops them).
+    pub fn checked(&self) -> Option<Arc<CheckedCols>> {
+        self.carry.as_ref()?.checked.clone()
     }
 
     fn append(
@@ -305,7 +338,7 @@ impl UpdatedLu {
         w: MatRef<'_, f64>,
         i: usize,
         cls: Class,
-        target: Option<&[f64]>,
+        target: Option<&[Vec<f64>]>,
     ) -> Option<()> {
         let c = &equilibrated(c);
         let new = node_rows(c, w, i, cls);
@@ -393,19 +426,26 @@ impl UpdatedLu {
         if cinv.iter().any(|v| !v.is_finite()) {
             return None;
         }
-        // The carried right-hand side and its base solution: b changes in node i's rows.
+        // The carried right-hand sides and their base solutions: each b changes in node
+        // i's rows.
         self.carry = match (self.carry.take(), target) {
-            (Some(cr), Some(t)) => {
+            (Some(cr), Some(ts)) if ts.len() == cr.b.len() => {
                 let mut cr = Arc::unwrap_or_clone(cr);
-                for (a, row) in [i, c.p + i].into_iter().enumerate() {
-                    let delta = t[row] - cr.b[row];
-                    if delta != 0.0 {
-                        axpy(&mut cr.x0, delta, &upd.z[a]);
+                for ((b, x0), t) in cr.b.iter_mut().zip(cr.x0.iter_mut()).zip(ts) {
+                    for (a, row) in [i, c.p + i].into_iter().enumerate() {
+                        let delta = t[row] - b[row];
+                        if delta != 0.0 {
+                            axpy(x0, delta, &upd.z[a]);
+                        }
+                        b[row] = t[row];
                     }
-                    cr.b[row] = t[row];
                 }
                 cr.y = None;
-                cr.x0.iter().all(|v| v.is_finite()).then(|| Arc::new(cr))
+                cr.checked = None;
+                cr.x0
+                    .iter()
+                    .all(|x0| x0.iter().all(|v| v.is_finite()))
+                    .then(|| Arc::new(cr))
             }
             _ => None,
         };
@@ -421,14 +461,7 @@ impl UpdatedLu {
     /// `(D_S M_S)⁻¹ b` for every column `b` (already in `r0` units): one pass over the
     /// base's factor for all of them, then the capacitance correction column by column.
     fn solve(&self, bs: &[Vec<f64>]) -> Vec<Vec<f64>> {
-        let m = self.base.lu.n();
-        let mut xm = faer::Mat::<f64>::from_fn(m, bs.len(), |i, c| bs[c][i]);
-        self.base.lu.solve_mat(xm.as_mut());
-        self.correct_many(
-            (0..bs.len())
-                .map(|c| xm.col(c).iter().copied().collect())
-                .collect(),
-        )
+        self.correct_many(self.base_solve(bs))
     }
 
     /// `x0 − Z C⁻¹ V x0` for every x0 of `xs`: base solutions made the piece's (O(km)),
@@ -479,24 +512,25 @@ impl UpdatedLu {
         self.solve(&scaled)
     }
 
-    /// The solution `y` of the carried right-hand side (see [`Carried`]), if any (O(km)):
-    /// unchecked (the caller checks it by its residual from the data, [`residual_rows`]).
-    pub fn carried(&self) -> Option<Vec<f64>> {
+    /// The solutions `y` of the carried right-hand sides (see [`Carried`]), if any
+    /// (O(km) each): unchecked (the caller checks them by their residuals from the data,
+    /// [`residual_rows`]).
+    pub fn carried(&self) -> Option<Vec<Vec<f64>>> {
         let cr = self.carry.as_deref()?;
         Some(match &cr.y {
             Some(y) => y.clone(),
-            None => self.correct_many(vec![cr.x0.clone()]).pop()?,
+            None => self.correct_many(cr.x0.clone()),
         })
     }
 
-    /// `(D M_0)⁻¹ b` (b in `r0` units): one pass over the base's factor.
-    fn base_solve(&self, b: &[f64]) -> Vec<f64> {
-        let mut x = b.to_vec();
-        let m = x.len();
-        self.base
-            .lu
-            .solve_mat(faer::MatMut::from_column_major_slice_mut(&mut x, m, 1));
-        x
+    /// `(D M_0)⁻¹ b` for each b (in `r0` units): one pass over the base's factor.
+    fn base_solve(&self, bs: &[Vec<f64>]) -> Vec<Vec<f64>> {
+        let m = self.base.lu.n();
+        let mut xm = faer::Mat::<f64>::from_fn(m, bs.len(), |i, c| bs[c][i]);
+        self.base.lu.solve_mat(xm.as_mut());
+        (0..bs.len())
+            .map(|c| xm.col(c).iter().copied().collect())
+            .collect()
     }
 
     /// `M_S⁻¹ b` with its check (see [`Self::solve_checked_many`]).
