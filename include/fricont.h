@@ -1338,7 +1338,10 @@ fricont_status fricont_path_start(struct fricont_path *path,
  * after `FRICONT_END_BIFURCATION` and `fricont_path_choose_branch`). Errors:
  * `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK`,
  * `FRICONT_ERR_CALLBACK_VALUE` (the path then ends with `FRICONT_END_FAILED`),
- * `FRICONT_ERR_NUMERICAL`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_NUMERICAL`, `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`. A load callback
+ * that fails ahead of the path is approached by shorter steps: the transitions before
+ * the failure are returned first, and the error where the path reaches it (to within
+ * 1e-12 of the window's length).
  *
  * # Safety
  * `path` is NULL or a live handle.

@@ -870,3 +870,80 @@ fn r_outside_its_range_is_refused() {
         assert_eq!(p.with_r(r).unwrap().r(), r);
     }
 }
+
+/// A load that fails from α = 0.7 on, after a transition at α = 0.5 (one node, A = I,
+/// f = (0.5 − α, 0): in contact, sticking, while 0.5 − α > 0, open after; a hand
+/// derivation), given as a basis load and as a general load: the transition is reported
+/// first, and the failure where the path reaches it, not where a step looking ahead
+/// first met it. Whichever step sizes the march takes, only α ≤ 0.7 may pass.
+#[test]
+fn a_load_failing_ahead_is_reached_after_the_transitions_before_it() {
+    let problem = || {
+        let a = CsrMatrix::from_dense(2, 2, &[1.0, 0.0, 0.0, 1.0]).unwrap();
+        let n = CsrMatrix::from_dense(1, 2, &[1.0, 0.0]).unwrap();
+        let t = CsrMatrix::from_dense(1, 2, &[0.0, 1.0]).unwrap();
+        Arc::new(
+            ProblemBuilder::new(a, Storage::Full, n, t)
+                .friction_uniform(0.3)
+                .build()
+                .unwrap(),
+        )
+    };
+    let fail = |alpha: f64| LoadFailure {
+        code: 11,
+        message: format!("no data at {alpha}"),
+    };
+    let basis = Load::basis(
+        vec![vec![0.5, 0.0], vec![-1.0, 0.0]],
+        Box::new(move |al: f64, w: &mut [f64], dw: &mut [f64]| {
+            if al > 0.7 {
+                return Err(fail(al));
+            }
+            (w[0], w[1], dw[0], dw[1]) = (1.0, al, 0.0, 1.0);
+            Ok(())
+        }),
+    )
+    .unwrap();
+    let general = Load::general(
+        2,
+        Box::new(move |al: f64, out: &mut [f64]| {
+            if al > 0.7 {
+                return Err(fail(al));
+            }
+            (out[0], out[1]) = (0.5 - al, 0.0);
+            Ok(())
+        }),
+        None,
+    );
+    for (name, load) in [("basis", basis), ("general", general)] {
+        let mut path = Path::new(problem(), load, PathOptions::window(0.0, 2.0)).unwrap();
+        path.start(0.0, None).unwrap();
+        let e = no_panic(name, || path.run()).unwrap_err();
+        match e {
+            Error::Load { alpha, code, .. } => {
+                assert_eq!(code, 11, "{name}");
+                assert!(
+                    alpha > 0.7 && alpha <= 0.7 + 1e-9,
+                    "{name}: failed at {alpha}"
+                );
+            }
+            e => panic!("{name}: {e:?}"),
+        }
+        assert!(
+            matches!(path.end_reason(), Some(EndReason::Failed(_))),
+            "{name}: {:?}",
+            path.end_reason()
+        );
+        let ev = path.events();
+        assert_eq!(ev.len(), 1, "{name}: {ev:?}");
+        assert!(
+            (ev[0].alpha - 0.5).abs() <= 1e-12,
+            "{name}: {}",
+            ev[0].alpha
+        );
+        assert_eq!(
+            (ev[0].from, ev[0].to),
+            (fricont::Class::Stick, fricont::Class::Open)
+        );
+    }
+}

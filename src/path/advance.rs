@@ -593,9 +593,20 @@ impl Path {
             let at_bound = (bound - pa.alpha).abs() <= h;
             let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
             // The midpoint of an untrusted step is the end of the step that follows.
+            // Where the load cannot be evaluated (its callback failed), the step is
+            // shortened, so that the transitions before that point are still reported; the
+            // error ends the path only once the step can be shortened no more (within hmin
+            // of the failure).
             let (mut pb, mut gb) = match ahead.take() {
                 Some(m) if m.0.alpha == b_alpha => m,
-                _ => eval(self, b_alpha, false)?,
+                _ => match eval(self, b_alpha, false) {
+                    Ok(v) => v,
+                    Err(Error::Load { .. }) if h > hmin => {
+                        h *= 0.5;
+                        continue;
+                    }
+                    Err(e) => return Err(e),
+                },
             };
             // A guard the piece just entered (zero at a, increasing) that is negative at b:
             // the step overshoots the piece's first stretch; shorten it.
@@ -658,7 +669,14 @@ impl Path {
             // fails this test and shortens the step to its first half. A guard already
             // negative at the midpoint is a crossing inside the first half.
             if h > hmin {
-                let pm = eval(self, pa.alpha + 0.5 * delta, false)?;
+                let pm = match eval(self, pa.alpha + 0.5 * delta, false) {
+                    Ok(v) => v,
+                    Err(Error::Load { .. }) => {
+                        h = 0.5 * delta.abs();
+                        continue;
+                    }
+                    Err(e) => return Err(e),
+                };
                 let gm = &pm.1;
                 let untrusted = (0..gb.len()).any(|k| {
                     let (v0, v1, vm) = (ga[k].value, gb[k].value, gm[k].value);

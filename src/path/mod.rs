@@ -1441,7 +1441,10 @@ impl Path {
     /// Advances to the next transition point or to the end of the path.
     /// Errors: not started ([`Error::Usage`]), load failure ([`Error::Load`]; the path then
     /// ends with [`EndReason::Failed`] and keeps what it traced), numerical failure
-    /// (likewise).
+    /// (likewise). A basis or general load that fails ahead of the path is approached by
+    /// shorter steps: the transitions before the failure are reported first, and the
+    /// error comes where the path reaches the failure (to within 1e-12 of the window's
+    /// length).
     pub fn step(&mut self) -> Result<StepOutcome> {
         let _pool = self.pool_scope();
         let tr = self.trace_ref()?;
