@@ -84,6 +84,28 @@ fn trace_one_node(
         .collect()
 }
 
+/// Traces the one node (as [`trace_one_node`]) and checks its events against `want`: the
+/// same count, α to 1e-9, the same classes.
+fn check_one_node(
+    (c0, omega, phase): (f64, f64, f64),
+    (a0, a1): (f64, f64),
+    with_derivative: bool,
+    want: &[(f64, Class, Class)],
+) {
+    let got = trace_one_node((c0, omega, phase), (a0, a1), with_derivative);
+    let case = format!("c0 {c0} ω {omega} φ {phase} window ({a0}, {a1})");
+    assert_eq!(got.len(), want.len(), "{case}: events {got:?}");
+    for (g, w) in got.iter().zip(want) {
+        assert!(
+            (g.0 - w.0).abs() <= 1e-9,
+            "{case}: α {} expected {}",
+            g.0,
+            w.0
+        );
+        assert_eq!((g.1, g.2), (w.1, w.2), "{case}: at α = {}", w.0);
+    }
+}
+
 #[test]
 fn one_node_sine_load_finds_every_transition() {
     let want = roots(0.9, 20.0, 0.0, -5.0, 5.0);
@@ -112,19 +134,7 @@ fn one_node_sine_loads_at_many_phases_frequencies_and_directions() {
                     if c_start.abs() < 1e-3 {
                         continue;
                     }
-                    let with_derivative = cases % 2 == 0;
-                    let got = trace_one_node((c0, omega, phase), (a0, a1), with_derivative);
-                    let case = format!("c0 {c0} ω {omega} φ {phase} window ({a0}, {a1})");
-                    assert_eq!(got.len(), want.len(), "{case}: events {got:?}");
-                    for (g, w) in got.iter().zip(&want) {
-                        assert!(
-                            (g.0 - w.0).abs() <= 1e-9,
-                            "{case}: α {} expected {}",
-                            g.0,
-                            w.0
-                        );
-                        assert_eq!((g.1, g.2), (w.1, w.2), "{case}: at α = {}", w.0);
-                    }
+                    check_one_node((c0, omega, phase), (a0, a1), cases % 2 == 0, &want);
                     cases += 1;
                 }
             }
@@ -182,18 +192,7 @@ fn loads_with_periods_dividing_the_first_step_lose_no_excursion() {
     ];
     for (k, &(c0, om, phase, a0, a1)) in cases.iter().enumerate() {
         let want = roots(c0, om, phase, a0, a1);
-        let got = trace_one_node((c0, om, phase), (a0, a1), k % 2 == 0);
-        let case = format!("c0 {c0} ω {om} φ {phase} window ({a0}, {a1})");
-        assert_eq!(got.len(), want.len(), "{case}: events {got:?}");
-        for (g, w) in got.iter().zip(&want) {
-            assert!(
-                (g.0 - w.0).abs() <= 1e-9,
-                "{case}: α {} expected {}",
-                g.0,
-                w.0
-            );
-            assert_eq!((g.1, g.2), (w.1, w.2), "{case}: at α = {}", w.0);
-        }
+        check_one_node((c0, om, phase), (a0, a1), k % 2 == 0, &want);
     }
 }
 
