@@ -99,30 +99,17 @@ impl Path {
         let PieceSolver::Updated(u) = &*cur.lu else {
             return None;
         };
-        let qs = self.load.basis_vectors()?;
+        let rhs = self.basis_rhs(&cur.classes)?;
         // Carried by the updates to this piece and checked from the data when its tangent
         // was computed (Path::tangent_updated): nothing to solve.
-        let (y, wy) = match u.checked().filter(|k| k.0.len() == qs.len() + 1) {
+        let (y, wy) = match u.checked().filter(|k| k.0.len() == rhs.len()) {
             Some(k) => Arc::unwrap_or_clone(k),
-            None => {
-                let c = self.consts();
-                let zeros = vec![0.0; 2 * c.p];
-                let mut rhs: Vec<Vec<f64>> =
-                    qs.iter().map(|q| c.piece_rhs(&cur.classes, q)).collect();
-                let g = shift_gap(&zeros, self.problem.gap_equilibrated());
-                rhs.push(c.piece_rhs(&cur.classes, &g));
-                let cols: Vec<update::Rhs<'_>> =
-                    rhs.iter().map(|b| update::Rhs { b, guess: None }).collect();
-                let w = self.problem.delassus().w();
-                let solved = u.solve_checked_many(&c, w, &cols, self.row_bound());
-                if solved
-                    .iter()
-                    .any(|s| s.rel > 1e-12 || !s.x.iter().all(|v| v.is_finite()))
-                {
-                    return None;
-                }
-                solved.into_iter().map(|s| (s.x, s.wx)).unzip()
-            }
+            None => u.solve_cols(
+                &self.consts(),
+                self.problem.delassus().w(),
+                &rhs,
+                self.row_bound(),
+            )?,
         };
         Some(match self.refine_basis(cur, &y) {
             Some(r) => {
@@ -508,21 +495,21 @@ impl Path {
         // against the data (its combination kept where its residual is at rounding level,
         // else solved for), and its d kept for the join.
         let eval = |this: &mut Self, alpha: f64, exact: bool| -> Result<(Point, Vec<GuardRow>)> {
-            let (q, dq) = this.load.q(alpha, this.problem.delassus())?;
-            let qg = shift_gap(&q, this.problem.gap_equilibrated());
+            let at = this.point_at(Vec::new(), alpha)?;
+            let (qg, dq) = (shift_gap(&at.q, this.problem.gap_equilibrated()), &at.dq);
             let [lam, d, mut t, rate] = match (&basis, this.load.weights_at(alpha)) {
                 (Some(bs), Some((w, dw))) => {
-                    let [lam, d, t, rate] = bs.at(w, dw, &qg, &dq);
+                    let [lam, d, t, rate] = bs.at(w, dw, &qg, dq);
                     if !exact {
                         [lam, d, t, rate]
                     } else if let Some((lam, d)) = this.checked_point(cur, &qg, lam, bs.refined) {
                         [lam, d, t, rate]
                     } else {
-                        solve(this, &qg, &dq)
+                        solve(this, &qg, dq)
                     }
                 }
                 _ => {
-                    let [mut lam, mut d, t, rate] = solve(this, &qg, &dq);
+                    let [mut lam, mut d, t, rate] = solve(this, &qg, dq);
                     // A general load on a problem carried beyond double: the point refined
                     // in double-double (the solves at neighbouring α otherwise differ by
                     // cond · ε, more than the guards' thresholds on a slender body), its d
@@ -540,17 +527,7 @@ impl Path {
             if exact {
                 this.prime_gaps(alpha, &lam, d);
             }
-            let dw = this.load.weights_at(alpha).map(|(_, dw)| dw.to_vec());
-            Ok((
-                Point {
-                    lam,
-                    alpha,
-                    q,
-                    dq,
-                    dw,
-                },
-                table,
-            ))
+            Ok((Point { lam, ..at }, table))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
@@ -806,7 +783,7 @@ impl Path {
                 let (lam_r, q_r) = (pt.lam.clone(), pt.q.clone());
                 let d_r = self.gaps(&pt);
                 let through = |this: &mut Self, x: f64| -> Result<(Point, Vec<GuardRow>)> {
-                    let (q, dq) = this.load.q(x, this.problem.delassus())?;
+                    let at = this.point_at(Vec::new(), x)?;
                     let Some((w, dw)) = this.load.weights_at(x) else {
                         return Err(Error::Numerical(format!(
                             "the basis load's weights at alpha = {x:e} are missing"
@@ -814,23 +791,14 @@ impl Path {
                     };
                     let d: Vec<f64> = d_r
                         .iter()
-                        .zip(q.iter().zip(&q_r))
+                        .zip(at.q.iter().zip(&q_r))
                         .map(|(v, (a, b))| v + (a - b))
                         .collect();
                     let c: Vec<f64> = w.iter().zip(&w_r).map(|(a, b)| a - b).collect();
-                    let [lam, d, mut t, rate] = bs.combine(lam_r.clone(), d, &c, dw, &dq);
+                    let [lam, d, mut t, rate] = bs.combine(lam_r.clone(), d, &c, dw, &at.dq);
                     t.push(1.0);
                     let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
-                    Ok((
-                        Point {
-                            lam,
-                            alpha: x,
-                            q,
-                            dq,
-                            dw: Some(dw.to_vec()),
-                        },
-                        table,
-                    ))
+                    Ok((Point { lam, ..at }, table))
                 };
                 let (lo_a, hi_a) = (pa.alpha.min(pb.alpha), pa.alpha.max(pb.alpha));
                 let (mut x0, mut v0) = (root, tab[k].value);

@@ -844,6 +844,22 @@ impl Path {
         }
     }
 
+    /// The right-hand sides `rhs_S(q_j)` of a basis load's vectors for the piece
+    /// `classes`, then the gap's, `rhs_S(−(g, 0))` (the seed's row scaling): the piece's
+    /// solutions of these combine into its point and tangent at any α. None for other
+    /// loads.
+    fn basis_rhs(&self, classes: &[Class]) -> Option<Vec<Vec<f64>>> {
+        let qs = self.load.basis_vectors()?;
+        let c = self.consts();
+        let g = shift_gap(&vec![0.0; 2 * c.p], self.problem.gap_equilibrated());
+        Some(
+            qs.iter()
+                .chain(std::iter::once(&g))
+                .map(|q| c.piece_rhs(classes, q))
+                .collect(),
+        )
+    }
+
     /// The α column `∂H/∂α` of the piece Jacobian (raw coordinates).
     fn alpha_column(&self, classes: &[Class], dq: &[f64]) -> Vec<f64> {
         let c = self.consts();
@@ -985,13 +1001,7 @@ impl Path {
         let targets: Option<Vec<Vec<f64>>> = if self.load.is_affine() {
             Some(vec![neg.clone()])
         } else {
-            basis_dw.map(|(_, qs)| {
-                let g = shift_gap(&zeros, self.problem.gap_equilibrated());
-                qs.iter()
-                    .chain(std::iter::once(&g))
-                    .map(|q| c.piece_rhs(classes, q))
-                    .collect()
-            })
+            basis_dw.and_then(|_| self.basis_rhs(classes))
         };
         let add =
             |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| x + y).collect() };
@@ -1136,14 +1146,7 @@ impl Path {
                     let wys: Vec<Vec<f64>> = prods.collect();
                     check_cols(&u, ys, wys, bs)
                 }
-                (Some(bs), None) => {
-                    let cols: Vec<update::Rhs<'_>> =
-                        bs.iter().map(|b| update::Rhs { b, guess: None }).collect();
-                    let ks = u.solve_checked_many(&c, w, &cols, rb);
-                    ks.iter()
-                        .all(|k| k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()))
-                        .then(|| ks.into_iter().map(|k| (k.x, k.wx)).unzip())
-                }
+                (Some(bs), None) => u.solve_cols(&c, w, bs, rb),
                 _ => None,
             };
             let (y, wy) = tangent_of(&u, checked.as_ref())?;

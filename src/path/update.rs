@@ -246,9 +246,9 @@ impl UpdatedLu {
     /// `None` when an update makes C singular (then `M_S` is singular). With `carry_to`
     /// (the right-hand sides b of `M_S y = b` for `classes`, the seed's row scaling), the
     /// solutions carried by `self` are carried along (see [`Carried`]); they are dropped
-    /// when they do not end up solving for exactly those b. Each column of `extra` (the seed's
-    /// row scaling for `classes`) is solved for with the new piece matrix, without a
-    /// check, its pass over the base's factor shared with the new nodes' columns.
+    /// when they do not end up solving for exactly those b. Each column of `extra` (the
+    /// seed's row scaling for `classes`) is solved for with the new piece matrix, without
+    /// a check, its pass over the base's factor shared with the new nodes' columns.
     pub fn extend(
         &self,
         c: &PieceConstants<'_>,
@@ -324,6 +324,23 @@ impl UpdatedLu {
             cr.checked = (cols.0.len() == n && cols.1.len() == n).then(|| Arc::new(cols));
             self.carry = Some(Arc::new(cr));
         }
+    }
+
+    /// `M_S⁻¹ b` with W times it for every column `b` of `bs` (see
+    /// [`Self::solve_checked_many`]); None unless every one is finite with a relative
+    /// residual ≤ 1e-12.
+    pub fn solve_cols(
+        &self,
+        c: &PieceConstants<'_>,
+        w: MatRef<'_, f64>,
+        bs: &[Vec<f64>],
+        row_bound: f64,
+    ) -> Option<CheckedCols> {
+        let cols: Vec<Rhs<'_>> = bs.iter().map(|b| Rhs { b, guess: None }).collect();
+        let ks = self.solve_checked_many(c, w, &cols, row_bound);
+        ks.iter()
+            .all(|k| k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()))
+            .then(|| ks.into_iter().map(|k| (k.x, k.wx)).unzip())
     }
 
     /// The carried right-hand sides' solutions kept by [`Self::set_checked`] on this very
