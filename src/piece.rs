@@ -171,6 +171,31 @@ impl<'a> PieceConstants<'a> {
         [nu, t]
     }
 
+    /// Makes `lam` satisfy exactly the local equations of node classes `a` and `b` (a
+    /// point on both pieces, e.g. a transition point): `λ = 0` where either class is
+    /// open, `λt = ±F λν` where a class slips (the guard that a stick–slip transition
+    /// crosses). Those equations involve no W, so a solve meets them only to rounding;
+    /// at a point where every force vanishes, that rounding is the whole force. Nodes
+    /// slipping one way in `a` and the other in `b` are left as they are.
+    pub fn satisfy_local(&self, a: &[Class], b: &[Class], lam: &mut [f64]) {
+        let p = self.p;
+        for i in 0..p {
+            let slip = |c: Class| match c {
+                Class::SlipPlus => Some(self.friction[i]),
+                Class::SlipMinus => Some(-self.friction[i]),
+                _ => None,
+            };
+            if a[i] == Class::Open || b[i] == Class::Open {
+                lam[i] = 0.0;
+                lam[p + i] = 0.0;
+            } else if let Some(s) = slip(a[i]).or(slip(b[i]))
+                && slip(a[i]).unwrap_or(s) == slip(b[i]).unwrap_or(s)
+            {
+                lam[p + i] = s * lam[i];
+            }
+        }
+    }
+
     /// The constant part of the piece equations at fixed α: `M_S λ = rhs` with
     /// `rhs = −bᵀ (q − g)` row by row (also gives `M_S λ' = −bᵀ q'` when passed `q'`).
     pub fn piece_rhs(&self, classes: &[Class], qg: &[f64]) -> Vec<f64> {
@@ -779,6 +804,25 @@ mod tests {
                 assert!((s - b[r]).abs() < 1e-12, "row {r}: {s} vs {}", b[r]);
             }
         }
+    }
+
+    #[test]
+    fn transition_points_meet_the_local_equations_of_both_classes() {
+        use Class::*;
+        let friction = [0.5, 2.0, 1.0, 3.0, 0.25];
+        let c = PieceConstants {
+            p: 5,
+            friction: &friction,
+            r: 1.0,
+            r0: 1.0,
+        };
+        // Slip+ -> open; stick -> slip+ (λt = F λν); slip- -> stick (λt = −F λν);
+        // stick -> stick (untouched); slip+ -> slip− (untouched).
+        let a = [SlipPlus, Stick, SlipMinus, Stick, SlipPlus];
+        let b = [Open, SlipPlus, Stick, Stick, SlipMinus];
+        let mut lam = vec![1e-17, -2.0, -1.0, -4.0, -1.0, 3e-17, -4.0 + 1e-15, 1.0, 0.3, 0.1];
+        c.satisfy_local(&a, &b, &mut lam);
+        assert_eq!(lam, vec![0.0, -2.0, -1.0, -4.0, -1.0, 0.0, -4.0, 1.0, 0.3, 0.1]);
     }
 
     #[test]

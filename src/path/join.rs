@@ -401,7 +401,9 @@ impl Path {
     pub(super) fn apply(&mut self, pend: &PendingJoin, k: usize) -> Result<StepOutcome> {
         let cand = pend.cands[k].clone();
         self.commit_solver(&cand.lu);
-        let pt = pend.point.clone();
+        let mut pt = pend.point.clone();
+        self.consts()
+            .satisfy_local(&pend.from, &cand.classes, &mut pt.lam);
         let dir = cand.direction();
         let fold = dir != 0 && pend.last_dir != 0 && dir != pend.last_dir;
         let scale = self.force_scale(&pt);

@@ -1390,6 +1390,8 @@ impl Path {
         {
             pt.lam = lam;
         }
+        self.consts()
+            .satisfy_local(&cand.classes, &cand.classes, &mut pt.lam);
         self.commit_solver(&cand.lu);
         let start = self.state(&pt.lam, alpha, &cand.classes)?;
         let dir = cand.direction();
