@@ -270,6 +270,14 @@ pub(crate) fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
     faer::traits::pulp::Arch::new().dispatch(Axpy(y, a, x))
 }
 
+/// `out −= a b` (on the call's pool from order [`PARALLEL_MIN_ORDER`], see
+/// [`TracePoolScope`]).
+pub(crate) fn mat_mul_sub(out: MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_, f64>) {
+    par_kernel(a.nrows().max(a.ncols()), |par| {
+        faer::linalg::matmul::matmul(out, faer::Accum::Add, a, b, -1.0, par)
+    });
+}
+
 /// `W x` for every x (W square): one pass over W for all of them, on the calling thread
 /// (on the call's pool from order [`PARALLEL_MIN_ORDER`], see [`TracePoolScope`]).
 pub(crate) fn mat_mul(w: MatRef<'_, f64>, xs: &[&[f64]]) -> Vec<Vec<f64>> {

@@ -2,7 +2,9 @@
 //!
 //! Consecutive pieces differ in the classes of a few nodes, and the piece matrix
 //! `M_S = ∂H/∂λ` of a node's class touches only that node's two rows (ν-row `i`, t-row
-//! `p + i`). So, with one base `M_0` factorised by LU (O(m³), m = 2p), every nearby piece
+//! `p + i`). So, with one base `M_0` factorised by LU (its rows of open nodes and t-rows of
+//! slipping nodes eliminated first, see [`DenseLu::reduced`]: O(m_r³) with
+//! m_r = 2·stick + slip ≤ m = 2p), every nearby piece
 //! is `M_S = M_0 + U V` with `U = [E_1 … E_k]` (`E_j` = the two unit columns of the rows
 //! that changed at the j-th update) and `V` the stacked row differences (2k × m). Then
 //!
@@ -41,7 +43,9 @@ use crate::piece::{DenseLu, PieceConstants};
 /// on this project's machine: K ≈ m/12 at m = 960 and m/17 at m = 4000 (where the
 /// updates' columns no longer stay in cache); the total is flat near the least, and m/16
 /// also keeps the SMW sums short, so fewer solves need refining (half as many at
-/// m = 4000 as with m/8).
+/// m = 4000 as with m/8). (Measured with the LU of the whole M_S; the reduced LU costs
+/// about (m_r/m)³ of it, which moves the least to smaller K, but on the 308,160-dof mesh
+/// (m = 960) m/32 and m/24 traced no faster than m/16 within this machine's noise.)
 pub(crate) fn max_updates(m: usize) -> usize {
     (m / 16).max(8)
 }
@@ -189,10 +193,19 @@ fn node_rows(c: &PieceConstants<'_>, w: MatRef<'_, f64>, i: usize, cls: Class) -
 }
 
 impl UpdatedLu {
-    /// Factorises `M_S` afresh (O(m³)). `None` if it is exactly singular.
+    /// Factorises `M_S` afresh (O(m_r³), see the module doc). `None` if it is exactly
+    /// singular.
     pub fn factor(c: &PieceConstants<'_>, w: MatRef<'_, f64>, classes: &[Class]) -> Option<Self> {
         let c = &equilibrated(c);
-        let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
+        // The rows `λ = 0` of open nodes and the t-rows of slipping nodes are eliminated
+        // ahead of the LU (see [`DenseLu::reduced`]).
+        let eqs: Vec<_> = (0..c.p).map(|i| c.equations(i, classes[i])).collect();
+        let rows: Vec<_> = eqs
+            .iter()
+            .map(|e| e[0])
+            .chain(eqs.iter().map(|e| e[1]))
+            .collect();
+        let lu = DenseLu::reduced(w, &rows);
         if lu.det_sign == 0 || lu.pivot_ratio.is_nan() || lu.pivot_ratio <= 0.0 {
             return None;
         }
