@@ -116,8 +116,44 @@ impl Base {
 /// One rank-2 update: node `node`'s two rows changed by `v` (rows over λ).
 struct Update {
     node: usize,
-    v: [Vec<f64>; 2],
+    v: [RowChange; 2],
     z: Arc<NodeCols>,
+}
+
+/// The change of one row. Many are sparse: between stick and slip the ν-row (a row of W)
+/// does not change, between slip and open the t-row changes by `±F` at `λν` only, so
+/// their products cost nothing instead of a pass over m numbers.
+enum RowChange {
+    /// The nonzeros (index, value), at most [`SPARSE_MAX`].
+    Sparse(Vec<(usize, f64)>),
+    Dense(Vec<f64>),
+}
+
+/// Most nonzeros of a [`RowChange::Sparse`].
+const SPARSE_MAX: usize = 4;
+
+impl RowChange {
+    fn new(new: &[f64], old: &[f64]) -> Self {
+        let v: Vec<f64> = new.iter().zip(old).map(|(a, b)| a - b).collect();
+        if v.iter().filter(|x| **x != 0.0).count() <= SPARSE_MAX {
+            Self::Sparse(
+                v.into_iter()
+                    .enumerate()
+                    .filter(|(_, x)| *x != 0.0)
+                    .collect(),
+            )
+        } else {
+            Self::Dense(v)
+        }
+    }
+
+    /// The row times `x`.
+    fn dot(&self, x: &[f64]) -> f64 {
+        match self {
+            Self::Sparse(nz) => nz.iter().map(|&(j, v)| v * x[j]).sum(),
+            Self::Dense(v) => dot(v, x),
+        }
+    }
 }
 
 /// The base's solutions `x0 = (D M_0)⁻¹ b` of right-hand sides b carried from piece to
@@ -373,10 +409,7 @@ impl UpdatedLu {
         let c = &equilibrated(c);
         let new = node_rows(c, w, i, cls);
         let old = node_rows(c, w, i, self.classes[i]);
-        let v = [
-            new[0].iter().zip(&old[0]).map(|(a, b)| a - b).collect(),
-            new[1].iter().zip(&old[1]).map(|(a, b)| a - b).collect(),
-        ];
+        let v = [0, 1].map(|a| RowChange::new(&new[a], &old[a]));
         let z = self.base.z_of(i, c.p);
         let upd = Update { node: i, v, z };
         let k2 = 2 * self.updates.len();
@@ -386,15 +419,15 @@ impl UpdatedLu {
         for (j, u) in self.updates.iter().enumerate() {
             for a in 0..2 {
                 for b in 0..2 {
-                    bcol[(2 * j + a) + k2 * b] = dot(&u.v[a], &upd.z[b]);
-                    crow[a][2 * j + b] = dot(&upd.v[a], &u.z[b]);
+                    bcol[(2 * j + a) + k2 * b] = u.v[a].dot(&upd.z[b]);
+                    crow[a][2 * j + b] = upd.v[a].dot(&u.z[b]);
                 }
             }
         }
         let mut d = [[0.0; 2]; 2];
         for (a, row) in d.iter_mut().enumerate() {
             for (b, x) in row.iter_mut().enumerate() {
-                *x = dot(&upd.v[a], &upd.z[b]) + if a == b { 1.0 } else { 0.0 };
+                *x = upd.v[a].dot(&upd.z[b]) + if a == b { 1.0 } else { 0.0 };
             }
         }
         // Schur complement s = d − cb C⁻¹ b, with y = C⁻¹ b (k2 × 2), x = cb C⁻¹ (2 × k2);
@@ -505,7 +538,7 @@ impl UpdatedLu {
         for (j, u) in self.updates.iter().enumerate() {
             for a in 0..2 {
                 for (t, x) in xs.iter().enumerate() {
-                    vx[t][2 * j + a] = dot(&u.v[a], x);
+                    vx[t][2 * j + a] = u.v[a].dot(x);
                 }
             }
         }
@@ -744,4 +777,60 @@ pub(crate) fn row_bound(c: &PieceConstants<'_>, w: MatRef<'_, f64>) -> f64 {
     }
     let fmax = c.friction.iter().fold(0.0f64, |a, &b| a.max(b));
     (c.r * wn).max(1.0 + fmax)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_changes_between_neighbouring_classes_are_sparse_where_the_forms_say() {
+        // W = 2 I + 1 (dense), p = 3, F = 0.7 at node 1, r = r0 = 1.
+        let w = faer::Mat::<f64>::from_fn(6, 6, |i, j| if i == j { 3.0 } else { 1.0 });
+        let friction = [0.2, 0.7, 0.4];
+        let c = PieceConstants {
+            p: 3,
+            friction: &friction,
+            r: 1.0,
+            r0: 1.0,
+        };
+        let change = |from: Class, to: Class, row: usize| {
+            let (a, b) = (
+                node_rows(&c, w.as_ref(), 1, to),
+                node_rows(&c, w.as_ref(), 1, from),
+            );
+            RowChange::new(&a[row], &b[row])
+        };
+        let sparse = |r: RowChange| match r {
+            RowChange::Sparse(nz) => Some(nz),
+            RowChange::Dense(_) => None,
+        };
+        // Stick -> slip+: the ν-row (W's row 1) is kept; the t-row changes densely.
+        assert_eq!(
+            sparse(change(Class::Stick, Class::SlipPlus, 0)),
+            Some(vec![])
+        );
+        assert_eq!(sparse(change(Class::Stick, Class::SlipPlus, 1)), None);
+        // Slip+ -> open: λt − F λν = 0 becomes λt = 0, a change of +F at λν (index 1).
+        assert_eq!(
+            sparse(change(Class::SlipPlus, Class::Open, 1)),
+            Some(vec![(1, 0.7)])
+        );
+        assert_eq!(sparse(change(Class::SlipPlus, Class::Open, 0)), None);
+        // Slip+ -> slip−: −F λν becomes +F λν.
+        assert_eq!(
+            sparse(change(Class::SlipPlus, Class::SlipMinus, 1)),
+            Some(vec![(1, 1.4)])
+        );
+        // The products agree with the dense row's.
+        let x: Vec<f64> = (0..6).map(|k| 1.0 + k as f64).collect();
+        let dense = change(Class::Stick, Class::Open, 1);
+        let (a, b) = (
+            node_rows(&c, w.as_ref(), 1, Class::Open),
+            node_rows(&c, w.as_ref(), 1, Class::Stick),
+        );
+        let expect: f64 = (0..6).map(|k| (a[1][k] - b[1][k]) * x[k]).sum();
+        assert!((dense.dot(&x) - expect).abs() < 1e-13);
+        assert_eq!(change(Class::SlipPlus, Class::Open, 1).dot(&x), 0.7 * 2.0);
+    }
 }
