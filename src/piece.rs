@@ -470,7 +470,26 @@ impl DenseLu {
         let k = b.ncols();
         let zl = Mat::from_fn(r.local.len(), k, |l, j| b[(r.local[l], j)] / r.diag[l]);
         let mut xd = Mat::from_fn(r.kept.len(), k, |i, j| b[(r.kept[i], j)]);
-        crate::dense::mat_mul_sub(xd.as_mut(), r.dl.as_ref(), zl.as_ref());
+        // A piece's right-hand sides are zero in the local rows (λ = 0, λt ∓ F λν = 0),
+        // and a node's unit columns nonzero in one: only the columns of M_DL that meet a
+        // nonzero are read.
+        let nz: Vec<usize> = (0..r.local.len())
+            .filter(|&l| (0..k).any(|j| zl[(l, j)] != 0.0))
+            .collect();
+        if 4 * nz.len() >= r.local.len() {
+            crate::dense::mat_mul_sub(xd.as_mut(), r.dl.as_ref(), zl.as_ref());
+        } else {
+            for &l in &nz {
+                let col = r.dl.col(l).try_as_col_major().expect("contiguous");
+                for j in 0..k {
+                    let f = zl[(l, j)];
+                    if f != 0.0 {
+                        let out = xd.col_mut(j).try_as_col_major_mut().expect("contiguous");
+                        crate::dense::axpy(out.as_slice_mut(), -f, col.as_slice());
+                    }
+                }
+            }
+        }
         self.lu.solve_in_place(xd.as_mut());
         for j in 0..k {
             for (l, &row) in r.local.iter().enumerate() {
@@ -1055,14 +1074,33 @@ mod tests {
             let red = DenseLu::reduced(w.as_ref(), &rows);
             assert_eq!(red.n(), m);
             let plain = DenseLu::new(full.as_ref());
+            // A dense right-hand side; then, in one solve, one zero in the rows without W
+            // (a piece's) and a unit column (a node's): the sparse path of `solve_mat`.
             let b: Vec<f64> = (0..m).map(|_| rnd()).collect();
-            let x = red.solve(&b);
-            let scale: f64 = (0..m)
-                .map(|i| (0..m).map(|j| (full[(i, j)] * x[j]).abs()).sum::<f64>() + b[i].abs())
-                .fold(0.0, f64::max);
-            for i in 0..m {
-                let res: f64 = (0..m).map(|j| full[(i, j)] * x[j]).sum::<f64>() - b[i];
-                assert!(res.abs() <= 1e-11 * scale, "trial {trial} row {i}: {res:e}");
+            let b_piece: Vec<f64> = (0..m)
+                .map(|r| if rows[r].disp.coef == 0.0 { 0.0 } else { b[r] })
+                .collect();
+            let unit: Vec<f64> = (0..m)
+                .map(|r| if r == trial % m { 1.0 } else { 0.0 })
+                .collect();
+            let mut xs = Mat::from_fn(m, 2, |i, j| [&b_piece, &unit][j][i]);
+            red.solve_mat(xs.as_mut());
+            let solved = [
+                (&b, red.solve(&b)),
+                (&b_piece, xs.col(0).iter().copied().collect()),
+                (&unit, xs.col(1).iter().copied().collect()),
+            ];
+            for (j, (b, x)) in solved.into_iter().enumerate() {
+                let scale: f64 = (0..m)
+                    .map(|i| (0..m).map(|k| (full[(i, k)] * x[k]).abs()).sum::<f64>() + b[i].abs())
+                    .fold(0.0, f64::max);
+                for i in 0..m {
+                    let res: f64 = (0..m).map(|k| full[(i, k)] * x[k]).sum::<f64>() - b[i];
+                    assert!(
+                        res.abs() <= 1e-11 * scale,
+                        "trial {trial} col {j} row {i}: {res:e}"
+                    );
+                }
             }
             // The determinant's sign: the plain LU's, and the expansion's where it is
             // clearly away from zero.
