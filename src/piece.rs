@@ -171,6 +171,16 @@ impl<'a> PieceConstants<'a> {
         [nu, t]
     }
 
+    /// The rows of `M_S` for `classes` as linear forms: the ν-rows of nodes 0..p, then
+    /// their t-rows (the order of λ).
+    pub fn rows(&self, classes: &[Class]) -> Vec<LinForm> {
+        let eqs: Vec<_> = (0..self.p).map(|i| self.equations(i, classes[i])).collect();
+        eqs.iter()
+            .map(|e| e[0])
+            .chain(eqs.iter().map(|e| e[1]))
+            .collect()
+    }
+
     /// Makes `lam` satisfy exactly the local equations of node classes `a` and `b` (a
     /// point on both pieces, e.g. a transition point): `λ = 0` where either class is
     /// open, `λt = ±F λν` where a class slips (the guard that a stick–slip transition
@@ -927,15 +937,20 @@ fn node_residual(
 mod tests {
     use super::*;
 
-    #[test]
-    fn kernel_of_random_wide_matrix_is_annihilated() {
-        let mut s = 12345u64;
-        let mut rnd = || {
+    /// Uniform numbers in [−1, 1) on a grid of `1/half` (xorshift64 from `seed`).
+    fn uniform(seed: u64, half: u64) -> impl FnMut() -> f64 {
+        let mut s = seed;
+        move || {
             s ^= s << 13;
             s ^= s >> 7;
             s ^= s << 17;
-            (s % 2000) as f64 / 1000.0 - 1.0
-        };
+            (s % (2 * half)) as f64 / half as f64 - 1.0
+        }
+    }
+
+    #[test]
+    fn kernel_of_random_wide_matrix_is_annihilated() {
+        let mut rnd = uniform(12345, 1000);
         for m in [1, 2, 5, 9] {
             let j = Mat::<f64>::from_fn(m, m + 1, |_, _| rnd());
             let plu = PieceLu::new(j.as_ref()).unwrap();
@@ -1036,13 +1051,7 @@ mod tests {
 
     #[test]
     fn reduced_lu_solves_the_piece_matrix_and_keeps_its_determinant_sign() {
-        let mut s = 987654321u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s % 100_000) as f64 / 50_000.0 - 1.0
-        };
+        let mut rnd = uniform(987654321, 50_000);
         let classes_all = [Class::Open, Class::Stick, Class::SlipPlus, Class::SlipMinus];
         let mut checked_det = 0;
         for trial in 0..400 {
@@ -1064,12 +1073,7 @@ mod tests {
             let classes: Vec<Class> = (0..p)
                 .map(|_| classes_all[((rnd() + 1.0) * 2.0).min(3.0) as usize])
                 .collect();
-            let eqs: Vec<_> = (0..p).map(|i| c.equations(i, classes[i])).collect();
-            let rows: Vec<LinForm> = eqs
-                .iter()
-                .map(|e| e[0])
-                .chain(eqs.iter().map(|e| e[1]))
-                .collect();
+            let rows = c.rows(&classes);
             let full = c.piece_matrix(w.as_ref(), &classes);
             let red = DenseLu::reduced(w.as_ref(), &rows);
             assert_eq!(red.n(), m);

@@ -235,13 +235,7 @@ impl UpdatedLu {
         let c = &equilibrated(c);
         // The rows `λ = 0` of open nodes and the t-rows of slipping nodes are eliminated
         // ahead of the LU (see [`DenseLu::reduced`]).
-        let eqs: Vec<_> = (0..c.p).map(|i| c.equations(i, classes[i])).collect();
-        let rows: Vec<_> = eqs
-            .iter()
-            .map(|e| e[0])
-            .chain(eqs.iter().map(|e| e[1]))
-            .collect();
-        let lu = DenseLu::reduced(w, &rows);
+        let lu = DenseLu::reduced(w, &c.rows(classes));
         if lu.det_sign == 0 || lu.pivot_ratio.is_nan() || lu.pivot_ratio <= 0.0 {
             return None;
         }
