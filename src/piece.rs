@@ -352,7 +352,7 @@ struct Reduction {
 
 impl DenseLu {
     pub fn new(a: MatRef<'_, f64>) -> Self {
-        Self::from_lu(crate::dense::partial_piv_lu(a), None, Vec::new())
+        Self::from_lu(crate::dense::partial_piv_lu(a), None)
     }
 
     /// The LU of the matrix whose row `r` is the linear form `rows[r]` over λ (W
@@ -431,16 +431,17 @@ impl DenseLu {
         let red = Reduction {
             kept,
             local,
-            diag: diag.clone(),
+            diag,
             dl,
             ld,
         };
-        Self::from_lu(crate::dense::partial_piv_lu(s.as_ref()), Some(red), diag)
+        Self::from_lu(crate::dense::partial_piv_lu(s.as_ref()), Some(red))
     }
 
     /// Sign and pivot ratio from the LU's pivots and permutation with the eliminated
-    /// rows' diagonals `diag`.
-    fn from_lu(lu: crate::dense::PartialLu, red: Option<Reduction>, diag: Vec<f64>) -> Self {
+    /// rows' diagonals.
+    fn from_lu(lu: crate::dense::PartialLu, red: Option<Reduction>) -> Self {
+        let diag = red.iter().flat_map(|r| r.diag.iter().copied());
         let u = &lu.lu;
         let n = u.nrows();
         let mut sign: i8 = perm_parity(&lu.row_fwd);

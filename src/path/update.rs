@@ -13,8 +13,10 @@
 //! det M_S = det M_0 · det C
 //! ```
 //!
-//! Appending one update costs two solves with the base (O(m²)), 8km dot-product flops for
-//! the new border of C, and O(k²) for the bordered inverse of C; a solve costs O(m² + km).
+//! Appending one update costs two solves with the base (O(m_r m)), at most 8km
+//! dot-product flops for the new border of C (a row change that is sparse costs next to
+//! nothing, see [`RowChange`]), and O(k²) for the bordered inverse of C; a solve costs
+//! O(m_r m + km).
 //! The sign of `det C` is carried exactly as the product of the signs of the 2 × 2 Schur
 //! complements (the matrix determinant lemma), so orientations never come from a
 //! determinant's value. When more than [`max_updates`] updates have accumulated, or when
