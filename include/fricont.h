@@ -1434,10 +1434,12 @@ fricont_status fricont_path_event_state(const struct fricont_path *path,
 
 /**
  * Copies the start point (the fixed-α solution the path started from) into `*state`
- * (see `fricont_state`; may be NULL).
+ * (see `fricont_state`; may be NULL). Costs one back-solve with the factor of A, as
+ * `fricont_path_event_state` (u is computed on request, not kept).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_LENGTH`,
- * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_NUMERICAL` (the state's numbers are
+ * not finite), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`. No load callback is called.
  *
  * # Safety
  * As `fricont_path_event_state`.

@@ -48,7 +48,7 @@ fn random_problems_against_enumeration() {
         );
 
         // The start is one of the brute-force solutions.
-        let start = path.start_state().expect("started").clone();
+        let start = path.start_state().expect("started");
         let start_l = lambda_of(&start);
         assert!(
             br.solutions_at(case.a0)

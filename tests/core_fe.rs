@@ -32,7 +32,7 @@ fn fe_problems_against_enumeration() {
         let problem = Arc::new(data.problem());
         let mut path = trace(problem, data.affine_load(), case.a0, case.a1);
         let br = Brute::new(data);
-        let start = path.start_state().unwrap().clone();
+        let start = path.start_state().unwrap();
         let sl = lambda_of(&start);
         assert!(
             br.solutions_at(case.a0)

@@ -49,7 +49,7 @@ fn check_case(case: &Case, nsamples: usize) -> usize {
         let all = br.solutions_at(alpha);
         // from no guess
         let p = fresh(case, &problem, alpha, None);
-        let st = p.start_state().unwrap();
+        let st = &p.start_state().unwrap();
         assert!(st.residual <= 1e-12, "{ctx}: residual {:e}", st.residual);
         let l = lambda_of(st);
         assert!(
@@ -72,7 +72,7 @@ fn check_case(case: &Case, nsamples: usize) -> usize {
             );
             let g = lambda_of(&s.state);
             let p = fresh(case, &problem, alpha, Some(g.as_slice()));
-            let st = p.start_state().unwrap();
+            let st = &p.start_state().unwrap();
             assert!(
                 vclose(&lambda_of(st), &g, LTOL),
                 "{ctx}: α = {alpha}: started from the path's solution {g:?}, got {st:?}"
@@ -93,7 +93,7 @@ fn check_case(case: &Case, nsamples: usize) -> usize {
             for _ in 0..3 {
                 let g = DVector::from_fn(2 * data.p, |_, _| rng.range(-3.0, 3.0) * scale);
                 let p = fresh(case, &problem, alpha, Some(g.as_slice()));
-                let st = p.start_state().unwrap();
+                let st = &p.start_state().unwrap();
                 assert!(
                     vclose(&lambda_of(st), &all[0].1, LTOL),
                     "{ctx}: α = {alpha} from guess {g:?}: {st:?}, want {:?}",
@@ -109,7 +109,7 @@ fn check_case(case: &Case, nsamples: usize) -> usize {
         if br.solutions_at(e.alpha - 1e-7).len() == 1 && br.solutions_at(e.alpha + 1e-7).len() == 1
         {
             let p = fresh(case, &problem, e.alpha, None);
-            let st = p.start_state().unwrap();
+            let st = &p.start_state().unwrap();
             assert!(
                 vclose(&lambda_of(st), &lambda_ev(e), 1e-8),
                 "{ctx}: solve at event {} α = {}: {st:?} vs {:?}",
@@ -149,7 +149,7 @@ fn fixed_alpha_solves_fold_problem() {
     let problem = Arc::new(case.data.problem());
     for l in [[0.0, 0.0], [-1.0, -2.0], [-1.5, -2.5]] {
         let p = fresh(&case, &problem, -1.0, Some(&l));
-        let st = p.start_state().unwrap();
+        let st = &p.start_state().unwrap();
         assert!(
             vclose(&lambda_of(st), &DVector::from_column_slice(&l), 1e-12),
             "{st:?}"

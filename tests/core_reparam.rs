@@ -185,7 +185,7 @@ fn reparametrised_random_problems() {
         )
         .unwrap();
         start_path.start(case.a0, None).unwrap();
-        let start = lambda_of(start_path.start_state().unwrap());
+        let start = lambda_of(&start_path.start_state().unwrap());
         let Some(walk) = br.walk(case.a0, case.a1, &start) else {
             continue;
         };

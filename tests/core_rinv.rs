@@ -136,7 +136,7 @@ fn r_invariance_random_problems() {
         )
         .unwrap();
         p.start(case.a0, None).unwrap();
-        let start = lambda_of(p.start_state().unwrap());
+        let start = lambda_of(&p.start_state().unwrap());
         let expected: Option<Expected> = br.walk(case.a0, case.a1, &start).map(|w| {
             w.events
                 .iter()

@@ -158,7 +158,7 @@ fn sample_rect30_events_confirmed() {
             )
             .unwrap();
             p.start(alpha, None).unwrap();
-            let st = p.start_state().unwrap();
+            let st = &p.start_state().unwrap();
             assert_eq!(
                 st.classes[e.node],
                 class,

@@ -57,7 +57,7 @@ fn a_start_at_a_zero_force_vertex_traces_into_the_window() {
                 .unwrap_or_else(|e| panic!("{ctx}: {e}"));
             path.start(a0, None)
                 .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
-            let start = lambda_of(path.start_state().expect("started"));
+            let start = lambda_of(&path.start_state().expect("started"));
             let n_branches = path.branches().len().max(1);
             if n_branches > 1 {
                 with_branches += 1;

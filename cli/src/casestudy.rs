@@ -390,9 +390,7 @@ fn path_json(path: &mut Path, case: &CaseData, setup_s: f64, trace_s: f64) -> Re
             "lambda_n": d.lambda_n, "lambda_t": d.lambda_t, "u_n": d.u_n, "u_t": d.u_t,
         })
     };
-    if let Some(start) = path.start_state().cloned() {
-        v["start"]["state"] = vertex(&start);
-    }
+    v["start"]["state"] = vertex(&path.start_state()?);
     let list = path.events().to_vec();
     if let Some(events) = v["events"].as_array_mut() {
         for (e, ev) in list.iter().zip(events.iter_mut()) {
@@ -433,9 +431,7 @@ fn path_csv(path: &mut Path, case: &CaseData) -> Result<String> {
         }
         s.push('\n');
     };
-    if let Some(st) = path.start_state() {
-        row("start", 0, st);
-    }
+    row("start", 0, &path.start_state()?);
     let mut last = None;
     for e in path.events().to_vec() {
         if last == Some(e.transition) {

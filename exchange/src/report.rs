@@ -252,12 +252,14 @@ impl PathReport {
         } else {
             Value::Array(fr.iter().map(|&x| num(x)).collect())
         };
-        let start = path.start_state().map(|s| StartReport {
+        // None before the start; likewise if the start's back-solve fails (as the events'
+        // residuals below, which are then NaN).
+        let start = path.start_state().ok().map(|s| StartReport {
             alpha: s.alpha,
-            classes: s.classes.clone(),
+            classes: s.classes,
             residual: s.residual,
-            lambda_n: s.lambda_n.clone(),
-            lambda_t: s.lambda_t.clone(),
+            lambda_n: s.lambda_n,
+            lambda_t: s.lambda_t,
         });
         let list: Vec<Event> = path.events().to_vec();
         // Residuals only (no u is kept).
@@ -536,7 +538,7 @@ pub fn table(path: &mut Path, timing: Option<Timing>) -> String {
         opts.alpha_end
     );
     match path.start_state() {
-        Some(st) => {
+        Ok(st) => {
             let _ = writeln!(
                 s,
                 "start: alpha = {}, residual {:.1e}, {}",
@@ -545,8 +547,11 @@ pub fn table(path: &mut Path, timing: Option<Timing>) -> String {
                 class_counts(&st.classes)
             );
         }
-        None => {
+        Err(_) if !path.is_started() => {
             let _ = writeln!(s, "start: (path not started)");
+        }
+        Err(e) => {
+            let _ = writeln!(s, "start: (its state failed: {e})");
         }
     }
     let _ = writeln!(

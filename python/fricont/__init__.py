@@ -209,7 +209,15 @@ class Path:
         self.end_reason: str = reason if reason is not None else "none"
         #: The failure message when ``end_reason == "failed"``.
         self.end_message: Optional[str] = message
-        self.start: Optional[dict] = core.start_state()
+
+    @property
+    def start(self) -> Optional[dict]:
+        """The start point: ``alpha``, ``lambda_n``, ``lambda_t``, ``classes``,
+        ``residual`` (no u); None when the path never started. Its residual costs one
+        back-solve, done on each access (keep the dict rather than asking again).
+
+        Raises: :class:`NumericalError` when that solve fails (u overflows)."""
+        return self._core.start_state()
 
     def __repr__(self) -> str:
         return f"<fricont.Path: {len(self.events)} events, end {self.end_reason!r}>"

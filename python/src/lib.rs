@@ -533,12 +533,17 @@ impl Path {
         })
     }
 
-    /// The start state (alpha, lambda_n, lambda_t, classes, residual; no u).
+    /// The start state (alpha, lambda_n, lambda_t, classes, residual; no u), None before
+    /// start(). The residual takes one back-solve (with the GIL released).
     fn start_state<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
-        let path = self.lock(py)?;
-        path.start_state()
-            .map(|s| state_dict(py, s, false))
-            .transpose()
+        let st = py.detach(|| -> PyResult<Option<State>> {
+            let path = self.lock_detached()?;
+            if !path.is_started() {
+                return Ok(None);
+            }
+            path.start_state().map(Some).map_err(to_py)
+        })?;
+        st.map(|s| state_dict(py, &s, false)).transpose()
     }
 
     /// The full state at event k (0-based): u by one back-solve, with the GIL released.

@@ -1101,10 +1101,12 @@ pub unsafe extern "C" fn fricont_path_event_state(
 }
 
 /// Copies the start point (the fixed-α solution the path started from) into `*state`
-/// (see `fricont_state`; may be NULL).
+/// (see `fricont_state`; may be NULL). Costs one back-solve with the factor of A, as
+/// `fricont_path_event_state` (u is computed on request, not kept).
 ///
 /// Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`path`), `FRICONT_ERR_LENGTH`,
-/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+/// `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_NUMERICAL` (the state's numbers are
+/// not finite), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`. No load callback is called.
 ///
 /// # Safety
 /// As `fricont_path_event_state`.
@@ -1117,11 +1119,8 @@ pub unsafe extern "C" fn fricont_path_start_state(
         // SAFETY: NULL or a live handle, by contract.
         let h = unsafe { handle_ref(path, "path") }?;
         let h = h.read()?;
-        let st = h
-            .started()?
-            .start_state()
-            .ok_or_else(|| Failure::order(NOT_STARTED))?;
-        h.fill_state(st, state)?;
+        let st = h.started()?.start_state()?;
+        h.fill_state(&st, state)?;
         Ok(fricont_status::FRICONT_OK)
     })
 }

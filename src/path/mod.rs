@@ -261,7 +261,7 @@ pub struct Path {
 
 /// The traced data and the current position.
 struct Trace {
-    start: State,
+    start: StartPoint,
     events: Vec<Event>,
     pieces: Vec<PieceRecord>,
     cur: CurrentPiece,
@@ -282,6 +282,16 @@ struct Trace {
     /// The last transition, kept while a branch may still be chosen there.
     pending: Option<PendingJoin>,
     branches: Vec<Branch>,
+}
+
+/// The start point, whose full state [`Path::start_state`] computes on request.
+struct StartPoint {
+    alpha: f64,
+    /// λ (internal units).
+    lam: Vec<f64>,
+    classes: Vec<Class>,
+    /// The load there.
+    load: LoadSnapshot,
 }
 
 /// "At zero" thresholds at a point, in force units: `force` for a form in λ only (per
@@ -1393,7 +1403,12 @@ impl Path {
         self.consts()
             .satisfy_local(&cand.classes, &cand.classes, &mut pt.lam);
         self.commit_solver(&cand.lu);
-        let start = self.state(&pt.lam, alpha, &cand.classes)?;
+        let start = StartPoint {
+            alpha,
+            lam: pt.lam.clone(),
+            classes: cand.classes.clone(),
+            load: self.load.snapshot(alpha)?,
+        };
         let dir = cand.direction();
         let piece = PieceRecord {
             classes: cand.classes.clone(),

@@ -3,6 +3,15 @@
 
 use super::*;
 
+/// A point whose u [`Path::solve_points`] solves for.
+struct SolvePoint<'a> {
+    alpha: f64,
+    /// λ (internal units).
+    lam: Vec<f64>,
+    /// The load there.
+    load: &'a LoadSnapshot,
+}
+
 impl Path {
     /// True after a successful [`Path::start`].
     pub fn is_started(&self) -> bool {
@@ -14,9 +23,24 @@ impl Path {
         self.trace.as_ref().and_then(|t| t.end.as_ref())
     }
 
-    /// The start point (after [`Path::start`]).
-    pub fn start_state(&self) -> Option<&State> {
-        self.trace.as_ref().map(|t| &t.start)
+    /// The full state at the start point: u = A⁻¹ (f(α) + Bᵀλ) and the residual,
+    /// computed on request as an event's is ([`Path::event_state`]: with fricont's own
+    /// factor and an affine or basis load, by the backward half of a solve only), so a
+    /// trace that never asks does not pay for it. Never calls the load's closures.
+    /// Errors: not started ([`Error::Usage`]); the solve failed or u overflows.
+    pub fn start_state(&self) -> Result<State> {
+        let tr = self.trace_ref()?;
+        let s = &tr.start;
+        let point = SolvePoint {
+            alpha: s.alpha,
+            lam: s.lam.clone(),
+            load: &s.load,
+        };
+        let mut state = None;
+        self.solve_points(std::slice::from_ref(&point), |_, u, lam, residual| {
+            state = Some(self.state_with(lam, s.alpha, &s.classes, u.to_vec(), residual));
+        })?;
+        Ok(state.expect("one point solved"))
     }
 
     /// The events so far (empty before the start).
@@ -70,8 +94,7 @@ impl Path {
 
     /// Calls `each(k, u, λ, residual)` for every event `k` in `range`, in order (u empty
     /// without a solve; λ internal, shared by the events of a transition).
-    /// One back-solve per transition point, in blocks of 32, with buffers reused between
-    /// blocks.
+    /// One back-solve per transition point (see [`Path::solve_points`]).
     fn event_points(
         &self,
         range: std::ops::Range<usize>,
@@ -86,9 +109,7 @@ impl Path {
                 tr.events.len()
             )));
         }
-        let n = self.problem.n();
-        let has_solve = self.problem.delassus().has_solve();
-        // One solve per transition point in the range.
+        // One point per transition point in the range (its first event).
         let mut firsts: Vec<usize> = Vec::new();
         for k in range.clone() {
             if firsts
@@ -98,43 +119,74 @@ impl Path {
                 firsts.push(k);
             }
         }
+        let points: Vec<SolvePoint> = firsts
+            .iter()
+            .map(|&k| {
+                let e = &tr.events[k];
+                let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
+                SolvePoint {
+                    alpha: e.alpha,
+                    lam: self.lam_to_internal(&lam),
+                    load: &tr.event_loads[k],
+                }
+            })
+            .collect();
+        let mut k_next = range.start;
+        self.solve_points(&points, |c, u, lam, residual| {
+            // Every event of this point's transition, in order.
+            let t = tr.events[firsts[c]].transition;
+            while k_next < range.end && tr.events[k_next].transition == t {
+                each(k_next, u, lam, residual);
+                k_next += 1;
+            }
+        })
+    }
+
+    /// Calls `each(c, u, λ, residual)` for every point `c` of `points`, in order (u empty
+    /// without a solve; λ internal): u = A⁻¹ (f(α) + Bᵀλ) by one back-solve per point, in
+    /// blocks of 32 right-hand sides with buffers reused between blocks; with fricont's
+    /// own factor and an affine or basis load, by the backward half of the solve only
+    /// (the load's forward half is kept per load vector). The residuals of a block take
+    /// one pass over A. Never calls the load's closures. Errors: the solve failed or u
+    /// overflows; out of memory.
+    fn solve_points(
+        &self,
+        points: &[SolvePoint],
+        mut each: impl FnMut(usize, &[f64], &[f64], f64),
+    ) -> Result<()> {
+        let n = self.problem.n();
+        let has_solve = self.problem.delassus().has_solve();
         const BLOCK: usize = 32;
         let del = self.problem.delassus();
         let m = 2 * self.problem.p();
-        let bs = firsts.len().min(BLOCK);
+        let bs = points.len().clamp(1, BLOCK);
         let nu = if has_solve { n } else { 0 };
         let mut x =
             crate::error::try_zeros(nu, bs, "the right-hand sides of the back-solves for u")?;
         let mut u = crate::error::try_zeros(nu, bs, "the displacements u")?;
         let mut lams = faer::Mat::<f64>::zeros(m, bs);
         let nf = self.problem.delassus().load_len();
-        let mut fs = crate::error::try_zeros(nf, bs, "the loads at the events")?;
+        let mut fs = crate::error::try_zeros(nf, bs, "the loads at the points")?;
         let mut scratch = Vec::new();
-        // With half solves, only the backward half of each solve is done per event:
+        // With half solves, only the backward half of each solve is done per point:
         // the load's half is kept per load vector (affine and basis loads).
         let cached = has_solve && del.has_half_solve() && self.load.has_half();
-        let mut k_next = range.start;
-        for block in firsts.chunks(BLOCK) {
+        for (b, block) in points.chunks(BLOCK).enumerate() {
             let kb = block.len();
-            let mut inputs = Vec::with_capacity(kb);
-            for (c, &k) in block.iter().enumerate() {
-                let e = &tr.events[k];
-                let lam: Vec<f64> = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
-                let lam = self.lam_to_internal(&lam);
+            for (c, pt) in block.iter().enumerate() {
                 let f = fs.col_mut(c).try_as_col_major_mut().expect("contiguous");
                 let f = f.as_slice_mut();
-                self.load.force_into(e.alpha, &tr.event_loads[k], f);
+                self.load.force_into(pt.alpha, pt.load, f);
                 if has_solve {
-                    for (i, &l) in lam.iter().enumerate() {
+                    for (i, &l) in pt.lam.iter().enumerate() {
                         lams[(i, c)] = l;
                     }
                     let col = x.col_mut(c).try_as_col_major_mut().expect("contiguous");
                     let col = col.as_slice_mut();
-                    if !(cached && self.load.half_solved_into(e.alpha, &tr.event_loads[k], col)) {
+                    if !(cached && self.load.half_solved_into(pt.alpha, pt.load, col)) {
                         col.copy_from_slice(f);
                     }
                 }
-                inputs.push(lam);
             }
             if has_solve {
                 let mut xs = x.as_mut().subcols_mut(0, kb);
@@ -146,13 +198,13 @@ impl Path {
                     }
                     del.displacements(xs, lams.as_ref().subcols(0, kb), us)?;
                 } else {
-                    for (c, lam) in inputs.iter().enumerate() {
+                    for (c, pt) in block.iter().enumerate() {
                         let col = xs
                             .as_mut()
                             .col_mut(c)
                             .try_as_col_major_mut()
                             .expect("contiguous");
-                        self.problem.b().mul_t_vec_add(lam, col.as_slice_mut());
+                        self.problem.b().mul_t_vec_add(&pt.lam, col.as_slice_mut());
                     }
                     del.solve_mat_in_place(xs.as_mut())?;
                     us.copy_from(xs.as_ref());
@@ -165,23 +217,18 @@ impl Path {
                     &[]
                 }
             };
-            let points: Vec<(&[f64], &[f64], &[f64])> = inputs
+            let triples: Vec<(&[f64], &[f64], &[f64])> = block
                 .iter()
                 .enumerate()
-                .map(|(c, lam)| {
+                .map(|(c, pt)| {
                     let f = fs.col(c).try_as_col_major().expect("contiguous").as_slice();
-                    (ucol(c), &lam[..], f)
+                    (ucol(c), &pt.lam[..], f)
                 })
                 .collect();
             // One pass over A for the residuals of the whole block.
-            let residuals = crate::piece::residuals(&self.problem, &points, &mut scratch);
-            // Every event of this block's transitions, in order.
-            for (c, &k0) in block.iter().enumerate() {
-                let t = tr.events[k0].transition;
-                while k_next < range.end && tr.events[k_next].transition == t {
-                    each(k_next, ucol(c), &inputs[c], residuals[c]);
-                    k_next += 1;
-                }
+            let residuals = crate::piece::residuals(&self.problem, &triples, &mut scratch);
+            for (c, pt) in block.iter().enumerate() {
+                each(b * BLOCK + c, ucol(c), &pt.lam, residuals[c]);
             }
         }
         Ok(())
