@@ -451,3 +451,78 @@ fn residual_of_loads_near_the_largest_double() {
         }
     }
 }
+
+/// The path is homogeneous in the load and the gap: scaled by c, the same events (α, nodes,
+/// classes, flags) with λ times c. On 40 random problems, loads (and gaps) scaled up to
+/// 1e300 must trace exactly so, and up to 1e308 either so or with a clean error that says
+/// the numbers are near the largest double. (Above 1e154 the vertex snap squared the loads
+/// into inf / inf = NaN and stopped with "alpha = NaN"; near 1e308 the unit tangent
+/// overflowed into inf and the path ran to the window's end with no event: silently
+/// wrong.)
+#[test]
+fn loads_scaled_toward_the_largest_double_give_the_same_events_or_a_clean_error() {
+    let run = |case: &common::Case, c: f64| {
+        let load = Load::affine(
+            case.data.f0.iter().map(|v| v * c).collect(),
+            case.data.f1.iter().map(|v| v * c).collect(),
+        )
+        .unwrap();
+        let mut data = case.data.clone();
+        data.gap.iter_mut().for_each(|g| *g *= c);
+        let mut path = Path::new(
+            Arc::new(data.problem()),
+            load,
+            PathOptions::window(case.a0, case.a1),
+        )
+        .unwrap();
+        let end = path.start(case.a0, None).and_then(|()| path.run());
+        (end, path.events().to_vec())
+    };
+    let mut scaled_runs = 0;
+    for seed in 0..40 {
+        let case = random_case(seed);
+        let (end, base) = run(&case, 1.0);
+        let end = end.unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let fmax = case.data.f0.amax().max(case.data.f1.amax()) * (1.0 + case.a0.abs());
+        for target in [1e100, 1e160, 1e250, 1e300, 1e306, 1e308] {
+            let c = target / fmax;
+            let ctx = format!("seed {seed}, load {target:e}");
+            match run(&case, c) {
+                (Ok(e), events) => {
+                    assert_eq!(e, end, "{ctx}");
+                    assert_eq!(events.len(), base.len(), "{ctx}: {events:?} vs {base:?}");
+                    for (x, y) in base.iter().zip(&events) {
+                        assert!(
+                            (x.alpha - y.alpha).abs() <= 1e-9 * (1.0 + x.alpha.abs()),
+                            "{ctx}: {x:?} vs {y:?}"
+                        );
+                        assert_eq!(
+                            (x.node, x.from, x.to, x.fold, x.bifurcation),
+                            (y.node, y.from, y.to, y.fold, y.bifurcation),
+                            "{ctx}"
+                        );
+                        let lx: Vec<f64> = x.lambda_n.iter().chain(&x.lambda_t).copied().collect();
+                        let ly: Vec<f64> = y.lambda_n.iter().chain(&y.lambda_t).copied().collect();
+                        let big = inf(&lx).max(1e-300);
+                        for (a, b) in lx.iter().zip(&ly) {
+                            assert!(
+                                (a - b / c).abs() <= 1e-9 * big,
+                                "{ctx}: λ {lx:?} vs {ly:?} / c"
+                            );
+                        }
+                    }
+                    scaled_runs += 1;
+                }
+                (Err(Error::Numerical(m)), _) if target > 1e300 => {
+                    assert!(m.contains("near the largest double"), "{ctx}: {m}");
+                }
+                (Err(e), _) => panic!("{ctx}: {e}"),
+            }
+        }
+    }
+    // Nearly all scaled runs trace (a clean error is the exception near 1e308).
+    assert!(
+        scaled_runs >= 230,
+        "{scaled_runs} of 240 scaled runs traced"
+    );
+}

@@ -166,9 +166,10 @@ impl Path {
         let options: Vec<Vec<Class>> = self.compatible(nodes, pt, &tol);
         if let Some(k) = options.iter().position(|o| o.is_empty()) {
             return Err(Error::Numerical(format!(
-                "node {} fits no class at alpha = {:e} (the point is not a solution)",
+                "node {} fits no class at alpha = {:e} (the point is not a solution){}",
                 nodes[k] + 1,
-                pt.alpha
+                pt.alpha,
+                near_overflow(pt)
             )));
         }
         let is_vertex: Vec<bool> = options.iter().map(|o| o.len() == 4).collect();
@@ -308,9 +309,10 @@ impl Path {
         };
         if cands.is_empty() {
             return Err(Error::Numerical(format!(
-                "no neighbouring piece continues the path at alpha = {:e} (nodes {:?})",
+                "no neighbouring piece continues the path at alpha = {:e} (nodes {:?}){}",
                 pt.alpha,
-                nodes.iter().map(|i| i + 1).collect::<Vec<_>>()
+                nodes.iter().map(|i| i + 1).collect::<Vec<_>>(),
+                near_overflow(&pt)
             )));
         }
         let bifurcation = cands.len() > 1;
@@ -378,19 +380,30 @@ impl Path {
         let alpha = if self.load.is_affine() {
             // From the load's parts, α* = −(q0 − g)·q1 / |q1|²: exactly 0 for a homogeneous
             // load (q0 = g = 0), where every tolerance at the vertex is relative to zero.
+            // Both parts are divided by their largest entry first: the squares of loads
+            // beyond 1e154 overflow (α* was inf / inf = NaN there, and a NaN point passed
+            // the test below).
             let (q0, q1) = self.load.q(0.0, self.problem.delassus())?;
             let qg = shift_gap(&q0, self.problem.gap_equilibrated());
-            let (num, den) = qg
-                .iter()
-                .zip(&q1)
-                .fold((0.0, 0.0), |(a, b), (x, y)| (a + x * y, b + y * y));
-            if den > 0.0 { -num / den } else { pt.alpha }
+            let s = inf_norm(&qg).max(inf_norm(&q1));
+            let (num, den) = qg.iter().zip(&q1).fold((0.0, 0.0), |(a, b), (x, y)| {
+                let (x, y) = (x / s, y / s);
+                (a + x * y, b + y * y)
+            });
+            let alpha = -num / den;
+            if den > 0.0 && alpha.is_finite() {
+                alpha
+            } else {
+                pt.alpha
+            }
         } else {
             pt.alpha
         };
         let snapped = self.point_at(vec![0.0; m], alpha)?;
         let qg = shift_gap(&snapped.q, self.problem.gap_equilibrated());
-        if self.problem.default_r() * inf_norm(&qg) <= tol.disp.max(z * reference) {
+        if qg.iter().all(|v| v.is_finite())
+            && self.problem.default_r() * inf_norm(&qg) <= tol.disp.max(z * reference)
+        {
             Ok(snapped)
         } else {
             Ok(pt)

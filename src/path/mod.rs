@@ -600,6 +600,22 @@ fn classes_hash(classes: &[Class]) -> u64 {
     h.finish()
 }
 
+/// A hint for a failure at a point whose forces or loads lie within a few orders of the
+/// largest double (beyond 2^1000 ≈ 1e301), where the tracer's products can overflow; empty
+/// elsewhere.
+fn near_overflow(pt: &Point) -> String {
+    let big = inf_norm(&pt.lam).max(inf_norm(&pt.q)).max(inf_norm(&pt.dq));
+    if big > 2f64.powi(1000) {
+        format!(
+            "; the forces and loads there reach {big:e}, near the largest double, where \
+             products overflow: scale the load and the gap down (the path's λ is \
+             proportional to them)"
+        )
+    } else {
+        String::new()
+    }
+}
+
 fn inf_norm(v: &[f64]) -> f64 {
     v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
@@ -1215,10 +1231,19 @@ impl Path {
         if !(norm.is_finite() && norm > 0.0) || t[m] / norm <= 1e-13 {
             return None;
         }
+        // (by S / norm, or, where that overflows (forces near the largest double), by 1 / norm
+        // and then S)
+        let by = |v: f64, s: f64| {
+            let f = s / norm;
+            if f.is_finite() { v * f } else { v / norm * s }
+        };
         for v in t.iter_mut().take(m) {
-            *v *= scales.force / norm;
+            *v = by(*v, scales.force);
         }
-        t[m] *= scales.alpha / norm;
+        t[m] = by(t[m], scales.alpha);
+        if t.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
         if fresh {
             *self.updater.borrow_mut() = Some(upd.clone());
         }
@@ -1354,8 +1379,9 @@ impl Path {
             .collect();
         let Some(&first) = verticals.first() else {
             return Err(Error::Numerical(format!(
-                "no piece leaves the start point alpha = {alpha} toward alpha_end = {}",
-                self.opts.alpha_end
+                "no piece leaves the start point alpha = {alpha} toward alpha_end = {}{}",
+                self.opts.alpha_end,
+                near_overflow(&pt)
             )));
         };
         // The start lies on a vertical piece (a continuum at this α): which way along it
