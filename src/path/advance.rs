@@ -18,8 +18,20 @@ fn dips(
 ) -> bool {
     (0..b.len()).any(|k| {
         let (m0, m1) = (a[k].slope * len, b[k].slope * len);
-        !skip(k) && hermite_min(a[k].value, b[k].value, m0, m1) < -tol[k]
+        let sc = overflow_guard(&[a[k].value, b[k].value, m0, m1]);
+        !skip(k) && hermite_min(a[k].value * sc, b[k].value * sc, m0 * sc, m1 * sc) < -tol[k] * sc
     })
+}
+
+/// 2^-8 where a number of `v` exceeds 2^1000 (guards near the largest double, whose
+/// Hermite models' sums would overflow), else 1: a scale for all of them (exact, and the
+/// models' tests are homogeneous in it).
+fn overflow_guard(v: &[f64]) -> f64 {
+    if v.iter().any(|x| x.abs() > 2f64.powi(1000)) {
+        2f64.powi(-8)
+    } else {
+        1.0
+    }
 }
 
 /// A guard with its value and its derivative along the tangent.
@@ -29,6 +41,29 @@ pub(super) struct GuardRow {
     pub(super) value: f64,
     /// Its derivative along the tangent (0 when no tangent is given).
     pub(super) slope: f64,
+}
+
+/// Most consecutive steps of at most `hmin` (1e-12 of the window) that a march along one
+/// piece of a nonlinear load takes before it stops with an error: such steps skip the step
+/// control, and a march that takes nothing longer has stalled.
+const MAX_FORCED_STEPS: usize = 1000;
+
+/// An error unless every guard of `rows` at `pt` is finite: past the range of a double
+/// (forces near 1e308) every comparison with a NaN is false, so no guard would cross and
+/// a march in α would neither advance nor stop.
+fn finite_guards(rows: &[GuardRow], pt: &Point) -> Result<()> {
+    if pt.alpha.is_finite()
+        && rows
+            .iter()
+            .all(|r| r.value.is_finite() && r.slope.is_finite())
+    {
+        return Ok(());
+    }
+    Err(Error::Numerical(format!(
+        "the guards at alpha = {:e} are not finite numbers{}",
+        pt.alpha,
+        near_overflow(pt)
+    )))
 }
 
 /// Where advancing on the current piece stops: the window's end, or a point where guards
@@ -263,6 +298,7 @@ impl Path {
             ..pt.clone()
         });
         let table = self.guard_table(&cur.classes, &pt, Some((&t, &rate)));
+        finite_guards(&table, &pt)?;
         let mut best: Option<(f64, Guard)> = None;
         let mut decreasing = Vec::new();
         let c = self.consts();
@@ -527,7 +563,9 @@ impl Path {
             if exact {
                 this.prime_gaps(alpha, &lam, d);
             }
-            Ok((Point { lam, ..at }, table))
+            let pt = Point { lam, ..at };
+            finite_guards(&table, &pt)?;
+            Ok((pt, table))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
@@ -554,6 +592,9 @@ impl Path {
         // again once it is back above its threshold, or where it turns down below it.
         let mut below: Option<Vec<bool>> = None;
         let mut ahead: Option<(Point, Vec<GuardRow>)> = None;
+        // Consecutive steps taken at h ≤ hmin, where the step control is skipped: a march
+        // that can take no longer step crawls at 1e-12 of the window and never ends.
+        let mut forced = 0usize;
         loop {
             let tol_at = self.tol_at(&pa);
             let tol: Vec<f64> = {
@@ -658,23 +699,40 @@ impl Path {
                 let untrusted = (0..gb.len()).any(|k| {
                     let (v0, v1, vm) = (ga[k].value, gb[k].value, gm[k].value);
                     let (m0, m1) = (ga[k].slope * delta, gb[k].slope * delta);
+                    // Guards near the largest double: the model's sums below overflow, and
+                    // an infinite model fails every step. All scaled by one power of two
+                    // (exact; the test is homogeneous in them).
+                    let sc = overflow_guard(&[v0, v1, vm, m0, m1]);
+                    let (v0, v1, vm, m0, m1) = (v0 * sc, v1 * sc, vm * sc, m0 * sc, m1 * sc);
+                    let tol_k = tol[k] * sc;
+                    let slope_m = gm[k].slope * delta * sc;
                     let model = 0.5 * (v0 + v1) + 0.125 * (m0 - m1);
-                    let margin = if v0 > tol[k] && v1 < -tol[k] {
+                    let margin = if v0 > tol_k && v1 < -tol_k {
                         v0.min(-v1)
                     } else {
-                        v0.min(v1).min(vm).max(tol[k])
+                        v0.min(v1).min(vm).max(tol_k)
                     };
                     // the model's slope at the midpoint, against the guard's there (an
                     // error symmetric about the midpoint leaves it, an asymmetric one not)
                     let model_slope = 1.5 * (v1 - v0) - 0.25 * (m0 + m1);
-                    (vm < -tol[k] && !below[k])
+                    (vm < -tol_k && !below[k])
                         || (vm - model).abs() > 0.25 * margin
-                        || (gm[k].slope * delta - model_slope).abs() > margin
+                        || (slope_m - model_slope).abs() > margin
                 });
                 if untrusted {
                     h = 0.5 * delta.abs();
                     ahead = Some(pm);
                     continue;
+                }
+                forced = 0;
+            } else {
+                forced += 1;
+                if forced > MAX_FORCED_STEPS {
+                    return Err(Error::Numerical(format!(
+                        "the march along a piece of the nonlinear load stalled at alpha = {:e}: {MAX_FORCED_STEPS} steps in a row of at most 1e-12 of the window passed no step control{}",
+                        pa.alpha,
+                        near_overflow(&pa)
+                    )));
                 }
             }
             self.graph_step.set(Some(delta.abs()));
