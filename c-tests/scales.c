@@ -98,6 +98,12 @@ static fricont_status trace(const case_data *c, int32_t storage, int64_t base, m
         if (path) fricont_path_error_message(path, msg, sizeof msg);
         goto done;
     }
+    /* the start state: u by one back-solve (an error where u overflows) */
+    st = fricont_path_start_state(path, NULL);
+    if (st != FRICONT_OK) {
+        fricont_last_error_message(msg, sizeof msg);
+        goto done;
+    }
     int64_t ne = 0, p = c->p;
     fricont_path_event_count(path, &ne);
     out->count = ne;
