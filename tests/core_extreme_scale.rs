@@ -404,6 +404,73 @@ fn condensed_w_near_the_largest_double() {
     }
 }
 
+/// A path (not started) over random case `case` with its load vectors and its gap scaled
+/// by `c`; `load` builds the load from f0·c and f1·c.
+fn scaled_path(case: &common::Case, c: f64, load: impl FnOnce(Vec<f64>, Vec<f64>) -> Load) -> Path {
+    let f0 = case.data.f0.iter().map(|v| v * c).collect();
+    let f1 = case.data.f1.iter().map(|v| v * c).collect();
+    let mut data = case.data.clone();
+    data.gap.iter_mut().for_each(|g| *g *= c);
+    let opts = PathOptions::window(case.a0, case.a1);
+    Path::new(Arc::new(data.problem()), load(f0, f1), opts).unwrap()
+}
+
+fn affine(f0: Vec<f64>, f1: Vec<f64>) -> Load {
+    Load::affine(f0, f1).unwrap()
+}
+
+/// Runs `scaled_path(case, c, load)` through its window, and checks it against the
+/// unscaled run `base` (`None`: returns this run as the base): the same end and the same
+/// events (α to 1e-9, nodes, classes, flags) with λ scaled by c; or, for a load scaled
+/// beyond 1e300 (`target`), an error that says the numbers are near the largest double.
+/// Returns whether it traced.
+fn check_scaled(
+    ctx: &str,
+    case: &common::Case,
+    c: f64,
+    target: f64,
+    load: impl FnOnce(Vec<f64>, Vec<f64>) -> Load,
+    base: Option<&(fricont::EndReason, Vec<Event>)>,
+) -> Option<(fricont::EndReason, Vec<Event>)> {
+    let mut path = scaled_path(case, c, load);
+    let end = path.start(case.a0, None).and_then(|()| path.run());
+    let events = path.events().to_vec();
+    let end = match end {
+        Ok(e) => e,
+        Err(Error::Numerical(m)) if target > 1e300 => {
+            assert!(m.contains("near the largest double"), "{ctx}: {m}");
+            return None;
+        }
+        Err(e) => panic!("{ctx}: {e}"),
+    };
+    let Some((base_end, base)) = base else {
+        return Some((end, events));
+    };
+    assert_eq!(&end, base_end, "{ctx}");
+    assert_eq!(events.len(), base.len(), "{ctx}: {events:?} vs {base:?}");
+    for (x, y) in base.iter().zip(&events) {
+        assert!(
+            (x.alpha - y.alpha).abs() <= 1e-9 * (1.0 + x.alpha.abs()),
+            "{ctx}: {x:?} vs {y:?}"
+        );
+        assert_eq!(
+            (x.node, x.from, x.to, x.fold, x.bifurcation),
+            (y.node, y.from, y.to, y.fold, y.bifurcation),
+            "{ctx}"
+        );
+        let lx: Vec<f64> = x.lambda_n.iter().chain(&x.lambda_t).copied().collect();
+        let ly: Vec<f64> = y.lambda_n.iter().chain(&y.lambda_t).copied().collect();
+        let big = inf(&lx).max(1e-300);
+        for (a, b) in lx.iter().zip(&ly) {
+            assert!(
+                (a - b / c).abs() <= 1e-9 * big,
+                "{ctx}: λ {lx:?} vs {ly:?} / c"
+            );
+        }
+    }
+    Some((end, events))
+}
+
 /// Loads near the largest double (entries up to 1e308 on ordinary A): the residual of a
 /// reported state is computed without overflow (its terms are scaled by a power of two
 /// first), so a correct state is not reported with an infinite residual. (Within a few
@@ -415,19 +482,7 @@ fn residual_of_loads_near_the_largest_double() {
         let fmax = case.data.f0.amax().max(case.data.f1.amax()) * (1.0 + case.a0.abs());
         for target in [1e306, 1e308] {
             let c = target / fmax;
-            let load = Load::affine(
-                case.data.f0.iter().map(|v| v * c).collect(),
-                case.data.f1.iter().map(|v| v * c).collect(),
-            )
-            .unwrap();
-            let mut data = case.data.clone();
-            data.gap.iter_mut().for_each(|g| *g *= c);
-            let mut path = Path::new(
-                Arc::new(data.problem()),
-                load,
-                PathOptions::window(case.a0, case.a1),
-            )
-            .unwrap();
+            let mut path = scaled_path(&case, c, affine);
             let state = path.start(case.a0, None).and_then(|()| path.start_state());
             match state {
                 Ok(s) => {
@@ -461,62 +516,16 @@ fn residual_of_loads_near_the_largest_double() {
 /// wrong.)
 #[test]
 fn loads_scaled_toward_the_largest_double_give_the_same_events_or_a_clean_error() {
-    let run = |case: &common::Case, c: f64| {
-        let load = Load::affine(
-            case.data.f0.iter().map(|v| v * c).collect(),
-            case.data.f1.iter().map(|v| v * c).collect(),
-        )
-        .unwrap();
-        let mut data = case.data.clone();
-        data.gap.iter_mut().for_each(|g| *g *= c);
-        let mut path = Path::new(
-            Arc::new(data.problem()),
-            load,
-            PathOptions::window(case.a0, case.a1),
-        )
-        .unwrap();
-        let end = path.start(case.a0, None).and_then(|()| path.run());
-        (end, path.events().to_vec())
-    };
     let mut scaled_runs = 0;
     for seed in 0..40 {
         let case = random_case(seed);
-        let (end, base) = run(&case, 1.0);
-        let end = end.unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let base = check_scaled(&format!("seed {seed}"), &case, 1.0, 1.0, affine, None);
         let fmax = case.data.f0.amax().max(case.data.f1.amax()) * (1.0 + case.a0.abs());
         for target in [1e100, 1e160, 1e250, 1e300, 1e306, 1e308] {
-            let c = target / fmax;
             let ctx = format!("seed {seed}, load {target:e}");
-            match run(&case, c) {
-                (Ok(e), events) => {
-                    assert_eq!(e, end, "{ctx}");
-                    assert_eq!(events.len(), base.len(), "{ctx}: {events:?} vs {base:?}");
-                    for (x, y) in base.iter().zip(&events) {
-                        assert!(
-                            (x.alpha - y.alpha).abs() <= 1e-9 * (1.0 + x.alpha.abs()),
-                            "{ctx}: {x:?} vs {y:?}"
-                        );
-                        assert_eq!(
-                            (x.node, x.from, x.to, x.fold, x.bifurcation),
-                            (y.node, y.from, y.to, y.fold, y.bifurcation),
-                            "{ctx}"
-                        );
-                        let lx: Vec<f64> = x.lambda_n.iter().chain(&x.lambda_t).copied().collect();
-                        let ly: Vec<f64> = y.lambda_n.iter().chain(&y.lambda_t).copied().collect();
-                        let big = inf(&lx).max(1e-300);
-                        for (a, b) in lx.iter().zip(&ly) {
-                            assert!(
-                                (a - b / c).abs() <= 1e-9 * big,
-                                "{ctx}: λ {lx:?} vs {ly:?} / c"
-                            );
-                        }
-                    }
-                    scaled_runs += 1;
-                }
-                (Err(Error::Numerical(m)), _) if target > 1e300 => {
-                    assert!(m.contains("near the largest double"), "{ctx}: {m}");
-                }
-                (Err(e), _) => panic!("{ctx}: {e}"),
+            let c = target / fmax;
+            if check_scaled(&ctx, &case, c, target, affine, base.as_ref()).is_some() {
+                scaled_runs += 1;
             }
         }
     }
@@ -533,72 +542,49 @@ fn loads_scaled_toward_the_largest_double_give_the_same_events_or_a_clean_error(
 /// its step control's Hermite model overflowed, so every longer step failed it.)
 #[test]
 fn nonlinear_loads_scaled_toward_the_largest_double_never_hang_or_mislead() {
-    let run = |case: &common::Case, c: f64, basis: bool| {
-        let f0: Vec<f64> = case.data.f0.iter().map(|v| v * c).collect();
-        let f1: Vec<f64> = case.data.f1.iter().map(|v| v * c).collect();
-        let load = if basis {
-            Load::basis(
-                vec![f0, f1],
-                Box::new(|a, w, dw| {
-                    w[0] = 1.0;
-                    w[1] = a + 0.3 * (3.0 * a).sin();
-                    dw[0] = 0.0;
-                    dw[1] = 1.0 + 0.9 * (3.0 * a).cos();
-                    Ok(())
-                }),
-            )
-            .unwrap()
-        } else {
-            let n = f0.len();
-            Load::general(
-                n,
-                Box::new(move |a, out| {
-                    let phi = a + 0.3 * (3.0 * a).sin();
-                    for (i, o) in out.iter_mut().enumerate() {
-                        *o = f0[i] + phi * f1[i];
-                    }
-                    Ok(())
-                }),
-                None,
-            )
+    let phi = |a: f64| a + 0.3 * (3.0 * a).sin();
+    let basis = |f0: Vec<f64>, f1: Vec<f64>| {
+        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+            (w[0], w[1]) = (1.0, phi(a));
+            (dw[0], dw[1]) = (0.0, 1.0 + 0.9 * (3.0 * a).cos());
+            Ok(())
         };
-        let mut data = case.data.clone();
-        data.gap.iter_mut().for_each(|g| *g *= c);
-        let mut path = Path::new(
-            Arc::new(data.problem()),
-            load,
-            PathOptions::window(case.a0, case.a1),
-        )
-        .unwrap();
-        let end = path.start(case.a0, None).and_then(|()| path.run());
-        (end, path.events().to_vec())
+        Load::basis(vec![f0, f1], Box::new(weights)).unwrap()
     };
-    for basis in [true, false] {
-        for seed in 0..20 {
-            let case = random_case(seed);
-            let (end, base) = run(&case, 1.0, basis);
-            let end = end.unwrap_or_else(|e| panic!("seed {seed}, basis {basis}: {e}"));
-            let fmax = case.data.f0.amax().max(case.data.f1.amax()) * (1.0 + case.a0.abs());
-            for target in [1e160, 1e300, 1e308] {
-                let ctx = format!("seed {seed}, basis {basis}, load {target:e}");
-                match run(&case, target / fmax, basis) {
-                    (Ok(e), events) => {
-                        assert_eq!(e, end, "{ctx}");
-                        assert_eq!(events.len(), base.len(), "{ctx}");
-                        for (x, y) in base.iter().zip(&events) {
-                            assert!(
-                                (x.alpha - y.alpha).abs() <= 1e-9 * (1.0 + x.alpha.abs()),
-                                "{ctx}: {x:?} vs {y:?}"
-                            );
-                            assert_eq!((x.node, x.from, x.to), (y.node, y.from, y.to), "{ctx}");
-                        }
-                    }
-                    (Err(Error::Numerical(m)), _) if target > 1e300 => {
-                        assert!(m.contains("near the largest double"), "{ctx}: {m}");
-                    }
-                    (Err(e), _) => panic!("{ctx}: {e}"),
-                }
+    let general = |f0: Vec<f64>, f1: Vec<f64>| {
+        let n = f1.len();
+        let f = move |a: f64, out: &mut [f64]| {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = f0[i] + phi(a) * f1[i];
             }
+            Ok(())
+        };
+        Load::general(n, Box::new(f), None)
+    };
+    for seed in 0..20 {
+        let case = random_case(seed);
+        let fmax = case.data.f0.amax().max(case.data.f1.amax()) * (1.0 + case.a0.abs());
+        let ctx = |kind: &str, target: f64| format!("seed {seed}, {kind} load {target:e}");
+        let base_b = check_scaled(&ctx("basis", 1.0), &case, 1.0, 1.0, basis, None);
+        let base_g = check_scaled(&ctx("general", 1.0), &case, 1.0, 1.0, general, None);
+        for target in [1e160, 1e300, 1e308] {
+            let c = target / fmax;
+            check_scaled(
+                &ctx("basis", target),
+                &case,
+                c,
+                target,
+                basis,
+                base_b.as_ref(),
+            );
+            check_scaled(
+                &ctx("general", target),
+                &case,
+                c,
+                target,
+                general,
+                base_g.as_ref(),
+            );
         }
     }
 }
