@@ -56,7 +56,8 @@ class Path:
     pieces: list[Piece]
     end_reason: str
     end_message: Optional[str]
-    start: Optional[dict[str, Any]]
+    @property
+    def start(self) -> Optional[dict[str, Any]]: ...
     def resume(
         self, monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None
     ) -> Path: ...
