@@ -23,11 +23,11 @@ fn dips(
     })
 }
 
-/// 2^-8 where a number of `v` exceeds 2^1000 (guards near the largest double, whose
-/// Hermite models' sums would overflow), else 1: a scale for all of them (exact, and the
-/// models' tests are homogeneous in it).
+/// 2^-8 where a number of `v` exceeds [`NEAR_OVERFLOW`] (guards near the largest double,
+/// whose Hermite models' sums would overflow), else 1: a scale for all of them (exact, and
+/// the models' tests are homogeneous in it).
 fn overflow_guard(v: &[f64]) -> f64 {
-    if v.iter().any(|x| x.abs() > 2f64.powi(1000)) {
+    if v.iter().any(|x| x.abs() > NEAR_OVERFLOW) {
         2f64.powi(-8)
     } else {
         1.0

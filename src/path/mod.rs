@@ -600,12 +600,15 @@ fn classes_hash(classes: &[Class]) -> u64 {
     h.finish()
 }
 
-/// A hint for a failure at a point whose forces or loads lie within a few orders of the
-/// largest double (beyond 2^1000 ≈ 1e301), where the tracer's products can overflow; empty
-/// elsewhere.
+/// Numbers beyond 2^1000 ≈ 1.07e301 lie within a few orders of the largest double, where
+/// sums and products of the tracer's quantities can overflow.
+const NEAR_OVERFLOW: f64 = f64::from_bits((1023 + 1000) << 52);
+
+/// A hint for a failure at a point whose forces or loads exceed [`NEAR_OVERFLOW`], where
+/// the tracer's products can overflow; empty elsewhere.
 fn near_overflow(pt: &Point) -> String {
     let big = inf_norm(&pt.lam).max(inf_norm(&pt.q)).max(inf_norm(&pt.dq));
-    if big > 2f64.powi(1000) {
+    if big > NEAR_OVERFLOW {
         format!(
             "; the forces and loads there reach {big:e}, near the largest double, where \
              products overflow: scale the load and the gap down (the path's λ is \
