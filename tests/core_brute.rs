@@ -19,7 +19,9 @@ mod common;
 
 use std::sync::Arc;
 
-use common::{Brute, check_state, lambda_of, random_case, samples, trace, vclose};
+use common::{
+    Brute, Case, check_state, lambda_of, large_friction_case, random_case, samples, trace, vclose,
+};
 use fricont::EndReason;
 use nalgebra::DVector;
 
@@ -30,14 +32,26 @@ const LAMBDA_TOL: f64 = 1e-9;
 
 #[test]
 fn random_problems_against_enumeration() {
+    against_enumeration(0..400, random_case);
+}
+
+/// Friction up to 5. Seeds 527, 3908 and 5017 start where the damped Newton, the
+/// active-set iteration and block Gauss–Seidel all stall (the start needs the friction
+/// continuation of the fixed-α solver).
+#[test]
+fn large_friction_problems_against_enumeration() {
+    against_enumeration((0..1000).chain([527, 3908, 5017]), large_friction_case);
+}
+
+fn against_enumeration(seeds: impl Iterator<Item = u64>, case_of: fn(u64) -> Case) {
     let mut walked = 0;
     let mut folds = 0;
     let mut events = 0;
     let mut multi = 0;
-    let seeds = 0..400u64;
-    let nseeds = seeds.end;
+    let mut nseeds = 0;
     for seed in seeds {
-        let case = random_case(seed);
+        nseeds += 1;
+        let case = case_of(seed);
         let data = &case.data;
         let problem = Arc::new(data.problem());
         let mut path = trace(problem, data.affine_load(), case.a0, case.a1);

@@ -825,14 +825,28 @@ pub struct Case {
 /// (0.05–0.3) for even seeds and up to 3 for odd seeds, a gap for every third seed,
 /// window of random length traced upward or downward.
 pub fn random_case(seed: u64) -> Case {
-    let mut rng = Rng::new(seed);
-    let p = 1 + (seed % 5) as usize;
-    let n = 2 * p + rng.int(0, 3);
-    let (fmin, fmax) = if seed.is_multiple_of(2) {
+    let friction = if seed.is_multiple_of(2) {
         (0.05, 0.3)
     } else {
         (0.05, 3.0)
     };
+    random_case_from(seed, Rng::new(seed), friction)
+}
+
+/// As [`random_case`] with large friction: 2–5 for even seeds, 0.05–5 for odd ones (its
+/// own random stream).
+pub fn large_friction_case(seed: u64) -> Case {
+    let friction = if seed.is_multiple_of(2) {
+        (2.0, 5.0)
+    } else {
+        (0.05, 5.0)
+    };
+    random_case_from(seed, Rng::new(seed ^ 0x5555), friction)
+}
+
+fn random_case_from(seed: u64, mut rng: Rng, (fmin, fmax): (f64, f64)) -> Case {
+    let p = 1 + (seed % 5) as usize;
+    let n = 2 * p + rng.int(0, 3);
     // Resample until W = B A⁻¹ Bᵀ is well conditioned (κ(W) ≤ 1e3): random dense N, T
     // can make B nearly rank-deficient, and then transition points are only determined
     // to κ·ε by the data themselves, whatever the algorithm.
