@@ -860,7 +860,7 @@ impl Delassus {
     }
 
     /// Condensed input: `w` is the caller's W (2p×2p) already divided symmetrically by
-    /// the node scales (`row_scale`, 2p entries: node i's scale in rows i and p + i), and
+    /// the row scales (`row_scale`, 2p entries, see [`crate::Problem::row_scale`]), and
     /// checked to be symmetric and positive definite by the caller, who also gives its
     /// Cholesky factor `l` (for the condition estimate).
     pub(crate) fn from_condensed(w: Mat<f64>, row_scale: Vec<f64>, l: MatRef<'_, f64>) -> Self {

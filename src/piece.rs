@@ -136,7 +136,7 @@ impl<'a> PieceConstants<'a> {
     pub fn of(problem: &'a Problem) -> Self {
         Self {
             p: problem.p(),
-            friction: problem.friction(),
+            friction: problem.friction_equilibrated(),
             r: problem.r(),
             r0: problem.default_r(),
         }
@@ -907,7 +907,7 @@ fn node_residual(
         let g = gap[i];
         let (ln, lt) = (lam[i], lam[p + i]);
         let h2 = ln - (ln - r * (bu[i] - g)).min(0.0);
-        let b = (-problem.friction()[i] * ln).max(0.0);
+        let b = (-problem.friction_equilibrated()[i] * ln).max(0.0);
         let h3 = lt - (lt - r * bu[p + i]).clamp(-b, b);
         let own = ln
             .abs()

@@ -657,7 +657,7 @@ impl ProblemBuilder {
             return Err(crate::condense::host_cannot_refine());
         }
         let mode = self.extended;
-        let (a, b, node_scale, delassus, a_scale_log2) = match self.source {
+        let (a, b, row_scale, delassus, a_scale_log2) = match self.source {
             Source::Matrix {
                 mut a,
                 storage,
@@ -676,7 +676,7 @@ impl ProblemBuilder {
                 let (b_unit, unit_scale) = equilibrated_b(&n, &t, n_dofs)?;
                 // A far from 1 in size (4e307, or subnormal entries) is scaled by an
                 // exact power of four before anything else is computed from it; the
-                // square root of that power goes into the node scales (see
+                // square root of that power goes into the row scales (see
                 // `stiffness_exponent`).
                 let k = stiffness_exponent(a.max_abs(), &unit_scale);
                 a.scale_pow2(k);
@@ -699,22 +699,22 @@ impl ProblemBuilder {
                 }
                 let mut b = b_unit;
                 b.scale_pow2(-k / 2);
-                let node_scale = unit_scale.iter().map(|s| s * h).collect();
-                (Some(full_a), b, node_scale, del, k)
+                let row_scale = unit_scale.iter().map(|s| s * h).collect();
+                (Some(full_a), b, row_scale, del, k)
             }
             Source::Solve { solve, n, t, .. } => {
-                let (b, node_scale) = equilibrated_b(&n, &t, n_dofs)?;
+                let (b, row_scale) = equilibrated_b(&n, &t, n_dofs)?;
                 let del = Delassus::from_host_solve(n_dofs, solve, &b)?;
-                (None, b, node_scale, del, 0)
+                (None, b, row_scale, del, 0)
             }
             Source::Condensed { w } => {
-                let (w_int, node_scale, l) = equilibrated_w(w)?;
-                let row_scale = (0..2 * p).map(|k| node_scale[k % p]).collect();
-                let del = Delassus::from_condensed(w_int, row_scale, l.as_ref());
-                (None, del.b().clone(), node_scale, del, 0)
+                let (w_int, row_scale, l) = equilibrated_w(w)?;
+                let del = Delassus::from_condensed(w_int, row_scale.clone(), l.as_ref());
+                (None, del.b().clone(), row_scale, del, 0)
             }
         };
-        let gap_eq: Vec<f64> = gap.iter().zip(&node_scale).map(|(g, s)| g / s).collect();
+        let gap_eq: Vec<f64> = gap.iter().zip(&row_scale).map(|(g, s)| g / s).collect();
+        let friction_eq = equilibrated_friction(&friction, &row_scale)?;
         let extended = delassus.w_lo().is_some()
             || (delassus.is_condensed()
                 && match mode {
@@ -741,7 +741,8 @@ impl ProblemBuilder {
             friction,
             gap,
             gap_eq,
-            node_scale,
+            friction_eq,
+            row_scale,
             a_scale_log2,
             r,
             r_default,
@@ -765,10 +766,10 @@ const A_BAND: i32 = 64;
 /// The problem `(A, f, λ, u, g)` is the same as
 /// `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u, 2^(-k/2) g)` with `B` unchanged; fricont
 /// factorises the latter, and traces with the rows of B divided by `2^(k/2)` on top of
-/// the node's own scale (forces `2^(k/2) λ` then pair with the caller's u and g), so W,
+/// the row's own scale (forces `2^(k/2) λ` then pair with the caller's u and g), so W,
 /// q and the forces the path works with stay in the range of ordinary numbers, and
-/// reports the former. The node scales
-/// `unit_scale[i] · 2^(k/2)` must stay within `[2^-1000, 2^1000]`: k is moved toward 0
+/// reports the former. The row scales
+/// `unit_scale[k] · 2^(k/2)` must stay within `[2^-1000, 2^1000]`: k is moved toward 0
 /// as far as they require (only for rows of N, T of absurd size).
 fn stiffness_exponent(max_abs: f64, unit_scale: &[f64]) -> i32 {
     let band = mul_pow2(1.0, -A_BAND)..=mul_pow2(1.0, A_BAND);
@@ -820,11 +821,13 @@ fn pow2_below(s: f64) -> f64 {
     mul_pow2(1.0, (s.log2().floor() as i32).clamp(-1074, 1023))
 }
 
-/// Equilibration: node i's rows N_i, T_i (and gap g_i) divided by
-/// `s_i`, the power of two at or below `max(‖N_i‖₂, ‖T_i‖₂)` (the rows are then of size
-/// 1 … 2, and the scaled data are the caller's digits exactly). The problem is invariant under such a per-node scaling
-/// (λ_i scales by s_i), and with unit rows no node's forces are measured on another
-/// node's scale. Returns `B = [N; T] / s` (2p×n) and the scales.
+/// Equilibration: each row of `B = [N; T]` divided by its scale `s_k`, the power of two at
+/// or below its 2-norm (the rows are then of size 1 … 2, and the scaled data are the
+/// caller's digits exactly). The problem is invariant under such a scaling: λ_k scales by
+/// `s_k`, the gap `g_i` by `1/s_i`, and node i's friction coefficient becomes
+/// `F_i s_{p+i} / s_i` ([`equilibrated_friction`]). With unit rows no force is measured
+/// on another's scale, not even a node's normal force on the scale of its own tangential
+/// row. Returns `B / s` (2p×n) and the 2p scales.
 fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMatrix, Vec<f64>)> {
     let p = n.nrows();
     // ‖row‖₂, scaled by the row's largest entry where the sum of squares would overflow or
@@ -844,24 +847,31 @@ fn equilibrated_b(n: &CsrMatrix, t: &CsrMatrix, n_dofs: usize) -> Result<(CsrMat
             .sum::<f64>()
             .sqrt()
     };
-    let node_scale: Vec<f64> = (0..p)
-        .map(|i| {
-            let s = row_norm(n, i).max(row_norm(t, i));
-            if s.is_finite() && s > 0.0 {
-                pow2_below(s)
+    let scale = |s: f64| {
+        if s.is_finite() && s > 0.0 {
+            pow2_below(s)
+        } else {
+            1.0
+        }
+    };
+    let row_scale: Vec<f64> = (0..2 * p)
+        .map(|k| {
+            if k < p {
+                scale(row_norm(n, k))
             } else {
-                1.0
+                scale(row_norm(t, k - p))
             }
         })
         .collect();
     let mut trip = Vec::with_capacity(n.nnz() + t.nnz());
-    for (i, &s) in node_scale.iter().enumerate() {
-        trip.extend(n.row(i).map(|(j, v)| (i, j, v / s)));
-        trip.extend(t.row(i).map(|(j, v)| (p + i, j, v / s)));
+    for i in 0..p {
+        let (sn, st) = (row_scale[i], row_scale[p + i]);
+        trip.extend(n.row(i).map(|(j, v)| (i, j, v / sn)));
+        trip.extend(t.row(i).map(|(j, v)| (p + i, j, v / st)));
     }
     Ok((
         CsrMatrix::from_triplets("B", 2 * p, n_dofs, &trip)?,
-        node_scale,
+        row_scale,
     ))
 }
 
@@ -918,10 +928,8 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>, Mat<f64>)> {
             w[(i, i)]
         )));
     }
-    let node_scale: Vec<f64> = (0..p)
-        .map(|i| pow2_below(w[(i, i)].max(w[(p + i, p + i)]).sqrt()))
-        .collect();
-    let sc = |k: usize| node_scale[k % p];
+    let row_scale: Vec<f64> = (0..m).map(|k| pow2_below(w[(k, k)].sqrt())).collect();
+    let sc = |k: usize| row_scale[k];
     let mut w_int = try_zeros(m, m, "the equilibrated W")?;
     for j in 0..m {
         for i in 0..m {
@@ -948,7 +956,30 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>, Mat<f64>)> {
             return Err(pivot_err(j, d));
         }
     }
-    Ok((w_int, node_scale, l))
+    Ok((w_int, row_scale, l))
+}
+
+/// Node i's friction coefficient for the equilibrated rows: `F_i s_{p+i} / s_i` (exact:
+/// the scales are powers of two), so that `|λt| ≤ F λν` in the caller's units is the same
+/// cone for the internal forces `s λ`. Error where it overflows (a friction coefficient
+/// near the largest double on a node whose tangential row is much longer than its normal
+/// one).
+fn equilibrated_friction(friction: &[f64], row_scale: &[f64]) -> Result<Vec<f64>> {
+    let p = friction.len();
+    (0..p)
+        .map(|i| {
+            let f = friction[i] * (row_scale[p + i] / row_scale[i]);
+            if f.is_finite() {
+                Ok(f)
+            } else {
+                Err(Error::InvalidParameter(format!(
+                    "friction coefficient F = {:e} at node {}: F times the ratio of the node's tangential and normal row norms overflows",
+                    friction[i],
+                    i + 1
+                )))
+            }
+        })
+        .collect()
 }
 
 /// Lower triangle (row ≥ col) and full storage of A, checking the storage convention and,
@@ -1156,7 +1187,9 @@ pub struct Problem {
     gap: Vec<f64>,
     /// Equilibrated gap `g_i / s_i`.
     gap_eq: Vec<f64>,
-    node_scale: Vec<f64>,
+    /// Equilibrated friction `F_i s_{p+i} / s_i`.
+    friction_eq: Vec<f64>,
+    row_scale: Vec<f64>,
     a_scale_log2: i32,
     r: f64,
     r_default: f64,
@@ -1204,23 +1237,26 @@ impl Problem {
     /// Extreme but valid scales (A × 4e307, subnormal entries) are factorised as
     /// ordinary numbers this way; results are reported in the caller's units. The problem
     /// `(A, f, λ, u, g)` is factorised as `(2^k A, 2^(k/2) f, 2^(k/2) λ, 2^(-k/2) u,
-    /// 2^(-k/2) g)`: `2^(k/2)` is part of [`Problem::node_scale`], and the residual of a
+    /// 2^(-k/2) g)`: `2^(k/2)` is part of [`Problem::row_scale`], and the residual of a
     /// state is that of the scaled equations. 0 for a host's solve and condensed data.
     pub fn a_scale_log2(&self) -> i32 {
         self.a_scale_log2
     }
-    /// The equilibrated `B = [N; T]` (2p×n; 2p×0 for condensed data): rows `0..p` are N, rows `p..2p` are T, node
-    /// i's two rows divided by [`Problem::node_scale`]`[i]`. W, the condensed loads and
-    /// every internal λ refer to these rows; the path reports λ in the caller's units.
+    /// The equilibrated `B = [N; T]` (2p×n; 2p×0 for condensed data): rows `0..p` are N,
+    /// rows `p..2p` are T, row k divided by [`Problem::row_scale`]`[k]`. W, the condensed
+    /// loads and every internal λ refer to these rows; the path reports λ in the caller's
+    /// units.
     pub fn b(&self) -> &CsrMatrix {
         &self.b
     }
-    /// The scale `s_i = max(‖N_i‖₂, ‖T_i‖₂) · 2^(k/2)` of each node's rows (1 for an empty
-    /// row; k = [`Problem::a_scale_log2`], 0 for ordinary A); for condensed data
-    /// `sqrt(max(W_ii, W_{p+i,p+i}))`.
-    /// Internal forces are `s_i λ_i` for the caller's `λ_i`.
-    pub fn node_scale(&self) -> &[f64] {
-        &self.node_scale
+    /// The scale `s_k` of each row of B (2p values: N's rows, then T's): the power of two
+    /// at or below `‖B_k‖₂ · 2^(k/2)` (1 for an empty row; k = [`Problem::a_scale_log2`],
+    /// 0 for ordinary A); for condensed data at or below `sqrt(W_kk)`. Internal forces are
+    /// `s_k λ_k` for the caller's `λ_k`; node i's internal gap is `g_i / s_i` and its
+    /// internal friction coefficient `F_i s_{p+i} / s_i`
+    /// ([`Problem::friction_equilibrated`]).
+    pub fn row_scale(&self) -> &[f64] {
+        &self.row_scale
     }
     /// Friction coefficients, one per node.
     pub fn friction(&self) -> &[f64] {
@@ -1233,6 +1269,11 @@ impl Problem {
     /// The equilibrated gap `g_i / s_i` (see [`Problem::b`]).
     pub fn gap_equilibrated(&self) -> &[f64] {
         &self.gap_eq
+    }
+    /// The friction coefficients of the equilibrated rows, `F_i s_{p+i} / s_i` (see
+    /// [`Problem::row_scale`]): the cone of the internal forces.
+    pub fn friction_equilibrated(&self) -> &[f64] {
+        &self.friction_eq
     }
     /// The augmentation parameter in use (force per length).
     pub fn r(&self) -> f64 {
@@ -1286,7 +1327,8 @@ impl Problem {
             friction: self.friction.clone(),
             gap: self.gap.clone(),
             gap_eq: self.gap_eq.clone(),
-            node_scale: self.node_scale.clone(),
+            friction_eq: self.friction_eq.clone(),
+            row_scale: self.row_scale.clone(),
             a_scale_log2: self.a_scale_log2,
             r,
             r_default: self.r_default,

@@ -12,7 +12,7 @@
 //! 2. **Projected block Gauss–Seidel** on the 2×2 node blocks, each local Coulomb
 //!    problem solved exactly by enumerating its four classes, followed by Newton again.
 //! 3. **Continuation in the friction coefficients** from the frictionless problem (see
-//!    [`friction_continuation`]).
+//!    `friction_continuation`).
 //! 4. Otherwise: [`crate::Error::SolveFailed`] saying what each stage reached.
 //!
 //! A returned `λ` always satisfies `‖H‖∞ ≤ 1e-12` relative to its force scale.

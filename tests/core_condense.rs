@@ -69,17 +69,20 @@ fn wide_rows_fall_back_to_solves_and_match_a_dense_reference() {
     .build()
     .unwrap();
     let am = DMatrix::from_row_slice(nd, nd, &a);
-    // The library equilibrates each node's rows by the power of two at or below
-    // max(‖N_i‖₂, ‖T_i‖₂): so does the reference, from the rows themselves.
+    // The library equilibrates each row of B by the power of two at or below its 2-norm:
+    // so does the reference, from the rows themselves.
     let norm = |r: &[f64]| r.iter().map(|v| v * v).sum::<f64>().sqrt();
     let mut b = DMatrix::zeros(2 * p, nd);
     for i in 0..p {
         let (nr, tr) = (&nrows[i * nd..(i + 1) * nd], &trows[i * nd..(i + 1) * nd]);
-        let s = 2f64.powf(norm(nr).max(norm(tr)).log2().floor());
-        assert_eq!(pb.node_scale()[i], s);
+        let (sn, st) = (
+            2f64.powf(norm(nr).log2().floor()),
+            2f64.powf(norm(tr).log2().floor()),
+        );
+        assert_eq!((pb.row_scale()[i], pb.row_scale()[p + i]), (sn, st));
         for j in 0..nd {
-            b[(i, j)] = nr[j] / s;
-            b[(p + i, j)] = tr[j] / s;
+            b[(i, j)] = nr[j] / sn;
+            b[(p + i, j)] = tr[j] / st;
         }
     }
     let w_ref = &b * am.lu().solve(&b.transpose()).unwrap();

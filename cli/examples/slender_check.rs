@@ -169,12 +169,12 @@ fn tracer_only(
 ) {
     let problem = case.problem(None).expect("problem");
     let p = case.p();
-    let s = problem.node_scale().to_vec();
+    let s = problem.row_scale().to_vec();
     let w_int = problem.delassus().w();
-    let w = nalgebra::DMatrix::from_fn(2 * p, 2 * p, |k, l| s[k % p] * w_int[(k, l)] * s[l % p]);
+    let w = nalgebra::DMatrix::from_fn(2 * p, 2 * p, |k, l| s[k] * w_int[(k, l)] * s[l]);
     let q = |f: &[f64]| {
         let v = problem.delassus().condense(f).expect("condense");
-        nalgebra::DVector::from_fn(2 * p, |k, _| s[k % p] * v[k])
+        nalgebra::DVector::from_fn(2 * p, |k, _| s[k] * v[k])
     };
     let (q0, q1) = (q(&case.f0), q(&case.f1));
     println!(

@@ -3,8 +3,8 @@
 //! Cholesky factor of A, against the independent double-double condensation of
 //! `tests/common/reference.rs` (its own envelope Cholesky and refined solves).
 //!
-//! fricont's W is that of the equilibrated rows: node i's rows of B divided by
-//! `Problem::node_scale()[i]` (a power of two, so the reference's W and q divided by the
+//! fricont's W is that of the equilibrated rows: row k of B divided by
+//! `Problem::row_scale()[k]` (a power of two, so the reference's W and q divided by the
 //! scales are exact).
 
 #[path = "../../tests/common/mod.rs"]
@@ -70,9 +70,9 @@ fn refined_w_and_q_match_the_double_double_reference_on_a_slender_beam() {
     let (w, w_lo) = (del.w(), del.w_lo().expect("W refined"));
     assert!(off.delassus().w_lo().is_none());
     let w_off = off.delassus().w();
-    let s = on.node_scale();
+    let s = on.row_scale();
     let p = on.p();
-    let sc = |k: usize| s[k % p];
+    let sc = |k: usize| s[k];
     let (mut err_hi, mut err, mut big) = (0.0f64, 0.0f64, 0.0f64);
     for j in 0..2 * p {
         for i in 0..2 * p {

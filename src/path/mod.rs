@@ -901,17 +901,17 @@ impl Path {
         col
     }
 
-    /// Forces in the caller's units from the internal (equilibrated) ones: node i's
-    /// `(λν_i, λt_i)` divided by [`Problem::node_scale`]`[i]`.
+    /// Forces in the caller's units from the internal (equilibrated) ones: `λ_k` divided
+    /// by [`Problem::row_scale`]`[k]`.
     fn lam_to_user(&self, lam: &[f64]) -> Vec<f64> {
-        let (s, p) = (self.problem.node_scale(), self.problem.p());
-        lam.iter().enumerate().map(|(k, v)| v / s[k % p]).collect()
+        let s = self.problem.row_scale();
+        lam.iter().zip(s).map(|(v, s)| v / s).collect()
     }
 
     /// The inverse of [`Self::lam_to_user`].
     fn lam_to_internal(&self, lam: &[f64]) -> Vec<f64> {
-        let (s, p) = (self.problem.node_scale(), self.problem.p());
-        lam.iter().enumerate().map(|(k, v)| v * s[k % p]).collect()
+        let s = self.problem.row_scale();
+        lam.iter().zip(s).map(|(v, s)| v * s).collect()
     }
 
     /// `d = q − (g, 0) + W λ` at a point (one product with W, cached for the last few
