@@ -944,9 +944,9 @@ fricont_status fricont_problem_set_gap(struct fricont_problem *problem,
  * Solutions, classes and transition points do not depend on r; it scales the
  * rows H2, H3 and so the reported residuals. Default: r = 2p / trace(W), the reciprocal
  * of the mean diagonal of the Delassus operator W = B A⁻¹ Bᵀ of the equilibrated rows
- * (each node's rows of N, T scaled to unit norm, and by a power of two for an A whose
- * largest entry lies outside [2^-64, 2^64]; the README's "Conventions"). Changing r keeps the
- * factorisation (no new Cholesky of A).
+ * (each row of N and of T scaled to about unit norm by a power of two, and by another
+ * for an A whose largest entry lies outside [2^-64, 2^64]; the README's "Conventions").
+ * Changing r keeps the factorisation (no new Cholesky of A).
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL` (`problem`), `FRICONT_ERR_RANGE` (r ≤ 0 or not
  * finite; or, once the problem is built, r outside [1e-6, 1e6] × the default — the
