@@ -114,10 +114,11 @@ pub(super) fn brent(a: f64, b: f64, fa: f64, fb: f64, mut f: impl FnMut(f64) -> 
 /// A root of `f` between `a` and `b`, where `f` changes sign, from values and slopes
 /// (`f` returns both): Newton steps kept inside the bracket, which shrinks at every
 /// evaluation, and a bisection wherever Newton would leave it or not halve the step
-/// before last (safeguarded Newton, as `rtsafe` in Numerical Recipes). Ends at the last
-/// point evaluated, once its value is within `accept` of zero, the Newton step from it is
-/// below machine precision in the argument, or the bracket is at machine precision. The
-/// first error of `f` ends the search and is returned.
+/// before last (safeguarded Newton, as `rtsafe` in Numerical Recipes). Ends once the
+/// value at the last point evaluated is within `accept` of zero (then at the Newton step
+/// from it, where that stays inside the bracket), the Newton step from it is below machine
+/// precision in the argument, or the bracket is at machine precision (then at that point).
+/// The first error of `f` ends the search and is returned.
 pub(super) fn newton_bracketed<E>(
     (a, fa, sa): (f64, f64, f64),
     (b, fb, sb): (f64, f64, f64),
@@ -135,7 +136,17 @@ pub(super) fn newton_bracketed<E>(
     for _ in 0..200 {
         let newton = x - fx / sx;
         let eps = 2.0 * f64::EPSILON * x.abs();
-        if fx.abs() <= accept || (newton - x).abs() <= eps || hi - lo <= 2.0 * eps {
+        if fx.abs() <= accept {
+            // The last Newton step, not evaluated: from a value this small it lands at
+            // the root to the rounding of the value (its error is the value's times the
+            // slope's relative error), where x is off by the value over the slope.
+            return Ok(if newton > lo && newton < hi {
+                newton
+            } else {
+                x
+            });
+        }
+        if (newton - x).abs() <= eps || hi - lo <= 2.0 * eps {
             break;
         }
         let y = if newton > lo && newton < hi && (2.0 * fx).abs() <= (dx_old * sx).abs() {
