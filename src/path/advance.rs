@@ -783,8 +783,9 @@ impl Path {
                 }
             }
             // The root of each crossing guard (safeguarded Newton on its values and
-            // slopes), to within 64 roundings of the guard's own scale (its tolerance is
-            // `zero_tol` of that scale): the earliest root wins.
+            // slopes), until the guard is within 64 roundings of its own scale (its
+            // tolerance is `zero_tol` of that scale), then one more Newton step, not
+            // evaluated (see [`newton_bracketed`]): the earliest root wins.
             let fine = (64.0 * f64::EPSILON / self.opts.zero_tol).min(0.25);
             let mut first: Option<(f64, Guard)> = None;
             for &k in &crossing {
