@@ -947,3 +947,31 @@ fn a_load_failing_ahead_is_reached_after_the_transitions_before_it() {
         );
     }
 }
+
+/// Each row of N and T is equilibrated by its own power of two, and node i's friction
+/// coefficient by their ratio (`F s_t / s_ν`): where that leaves the range of doubles (rows
+/// of 1e-300 and 1e300 at one node, ratio 2^1993) the build is an `InvalidParameter`
+/// naming the node; F = 0 and an F small enough for the ratio are accepted.
+#[test]
+fn friction_out_of_range_for_the_rows_of_its_node() {
+    let apart = |f: f64| {
+        ProblemBuilder::new(
+            dense(3, 3, &eye(3)),
+            Storage::Full,
+            dense(1, 3, &[1e-300, 0.0, 0.0]),
+            dense(1, 3, &[0.0, 1e300, 0.0]),
+        )
+        .friction_uniform(f)
+    };
+    let e = build_err("friction 1 on rows 1e-300, 1e300", apart(1.0));
+    assert!(
+        matches!(e, Error::InvalidParameter(ref m) if m.contains("node 1") && m.contains("2^1993")),
+        "{e}"
+    );
+    for f in [0.0, 1e-300] {
+        let p = no_panic("small friction", || apart(f).build()).unwrap();
+        assert_eq!(p.friction(), &[f]);
+        let fe = p.friction_equilibrated()[0];
+        assert!(fe.is_finite() && (fe > 0.0) == (f > 0.0), "{fe}");
+    }
+}
