@@ -369,12 +369,14 @@ pub enum Storage {
 /// the trace stops with [`crate::Error::Numerical`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum ExtendedPrecision {
-    /// Refine when W is ill-conditioned and refining is affordable: the estimate
-    /// [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e7) and the
-    /// refinement's estimated floating-point operations (about `2p · (16 nnz(L) + 36
-    /// nnz(A))`) are at most `max(20 × the factorisation's, 1e11)` ([`AUTO_COST_FLOPS`]:
-    /// about 10 s on one core). A host's solve is never refined; condensed input counts as extended when its
-    /// W is ill-conditioned (the tracer then works in double-double with the caller's W).
+    /// Refine when it is cheap, or when W is ill-conditioned and refining is affordable:
+    /// the refinement's estimated floating-point operations (about `2p · (16 nnz(L) + 36
+    /// nnz(A))`) are at most [`AUTO_SMALL_FLOPS`] (2e8, about 0.05 s on one core), or the
+    /// estimate [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e7) and
+    /// they are at most `max(20 × the factorisation's, 1e11)` ([`AUTO_COST_FLOPS`]: about
+    /// 10 s on one core). A host's solve is never refined; condensed input counts as
+    /// extended when its W is ill-conditioned (the tracer then works in double-double
+    /// with the caller's W).
     #[default]
     Auto,
     /// Always refine (condensed input: always trace in double-double). A host's solve is
@@ -402,6 +404,16 @@ pub const AUTO_COST_RATIO: f64 = 20.0;
 /// pieces' points would be off by up to κ ε ≈ 4e-5 relative. A 308,160-dof mesh with p = 480
 /// would need 8e11 (44 × its factorisation).
 pub const AUTO_COST_FLOPS: f64 = 1e11;
+
+/// [`ExtendedPrecision::Auto`] refines whatever W's condition where the refinement's
+/// estimated floating-point operations are at most this (2e8, about 0.05 s on one core:
+/// the repository's sample, n = 1320 and p = 30, needs about 6e7). Even a
+/// well-conditioned W, condensed in double, carries errors of κ(A) ε in its entries, and
+/// transitions where a guard crosses zero at a shallow angle amplify them and the
+/// trace's own rounding: on finite-element meshes of 12 to 37 × 1 to 3 elements with
+/// κ(W) ≈ 1e3–1e4, events in double were off by up to 5.5e-12 relative (against a
+/// double-double reference), and by at most 8.6e-13 refined and traced in double-double.
+pub const AUTO_SMALL_FLOPS: f64 = 2e8;
 
 /// Where the operator `A⁻¹` and `W` come from.
 #[derive(Debug, Clone)]
@@ -689,9 +701,11 @@ impl ProblemBuilder {
                     ExtendedPrecision::On => true,
                     ExtendedPrecision::Off => false,
                     ExtendedPrecision::Auto => {
-                        del.w_condition_estimate() > AUTO_CONDITION
-                            && del.refine_flops(full_a.nnz())
-                                <= (AUTO_COST_RATIO * del.factor_flops()).max(AUTO_COST_FLOPS)
+                        let flops = del.refine_flops(full_a.nnz());
+                        flops <= AUTO_SMALL_FLOPS
+                            || (del.w_condition_estimate() > AUTO_CONDITION
+                                && flops
+                                    <= (AUTO_COST_RATIO * del.factor_flops()).max(AUTO_COST_FLOPS))
                     }
                 };
                 if refine {

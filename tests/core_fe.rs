@@ -94,3 +94,49 @@ fn fe_problems_against_enumeration() {
     );
     assert!(walked * 4 >= total * 3, "too few generic cases");
 }
+
+/// Small meshes are refined by default (`ExtendedPrecision::Auto`, cost below
+/// `AUTO_SMALL_FLOPS`): their transition points agree with the double-double reference
+/// (`Brute::condensed_precise`, at the events where its two pieces meet to 1e-13) to
+/// 5e-13 relative. In double they were off by 5.5e-12, 1.3e-12 and 9.3e-13 on these three
+/// (W well conditioned, κ ≈ 4e3–8e3, but guards crossing zero at shallow angles).
+#[test]
+fn small_meshes_are_refined_and_their_events_exact() {
+    for (seed, nx, ny, friction) in [(219u64, 17, 1, 2.0), (175, 33, 2, 4.0), (109, 27, 1, 2.0)] {
+        let case = fe_case(seed, nx, ny, friction);
+        let data = &case.data;
+        let problem = Arc::new(data.problem());
+        assert!(problem.extended_precision(), "seed {seed}: not refined");
+        let path = trace(problem, data.affine_load(), case.a0, case.a1);
+        let br = Brute::condensed_precise(data);
+        let pieces = path.pieces();
+        let mut checked = 0;
+        for (k, e) in path.events().iter().enumerate() {
+            if e.bifurcation || k + 1 >= pieces.len() {
+                continue;
+            }
+            let near = |pc: common::BrutePiece| {
+                if (pc.lo - e.alpha).abs() < (pc.hi - e.alpha).abs() {
+                    pc.lo
+                } else {
+                    pc.hi
+                }
+            };
+            let before = near(br.piece_interval(&pieces[k].classes).expect("regular"));
+            let after = near(br.piece_interval(&pieces[k + 1].classes).expect("regular"));
+            let scale = before.abs().max(1.0);
+            // (the reference is only as exact as its pieces meet)
+            if (before - after).abs() > 1e-13 * scale {
+                continue;
+            }
+            assert!(
+                (e.alpha - before).abs() <= 5e-13 * scale,
+                "seed {seed}: event {} at {:.17e}, reference {before:.17e}",
+                k + 1,
+                e.alpha
+            );
+            checked += 1;
+        }
+        assert!(checked >= 10, "seed {seed}: {checked} events");
+    }
+}

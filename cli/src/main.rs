@@ -341,7 +341,12 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
     let problem = builder
         .build()
         .map_err(|e| input(format!("{}: {e}", args.dir.display())))?;
-    if problem.extended_precision() {
+    // A note where the refinement is for W's condition (a slender body) or was asked
+    // for; small problems are refined as a matter of course, without one.
+    if problem.extended_precision()
+        && (matches!(args.extended_precision, Extended::On)
+            || problem.w_condition_estimate() > fricont::problem::AUTO_CONDITION)
+    {
         eprintln!(
             "fricont: note: extended precision: W (condition estimate {:.1e}) refined beyond double in {:.2} s",
             problem.w_condition_estimate(),

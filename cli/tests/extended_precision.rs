@@ -136,10 +136,11 @@ fn refined_w_and_q_match_the_double_double_reference_on_a_slender_beam() {
     );
 }
 
-/// Auto refines the slender beam (W ill-conditioned, the refinement cheap) and not the
-/// sample (a 30 × 30 block: W well conditioned).
+/// Auto refines the slender beam (W ill-conditioned, the refinement affordable) and the
+/// sample (W well conditioned, but the refinement below `AUTO_SMALL_FLOPS`), and not a
+/// well-conditioned problem too large for that (a 121 × 81 rectangle, p = 120).
 #[test]
-fn auto_refines_the_slender_beam_and_not_the_sample() {
+fn auto_refines_the_slender_beam_and_small_problems() {
     let beam = build(&beam(), ExtendedPrecision::Auto);
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/sample-rect30");
     let sample = CaseData::read_dir(&dir)
@@ -155,8 +156,17 @@ fn auto_refines_the_slender_beam_and_not_the_sample() {
     assert!(beam.extended_precision() && beam.delassus().w_lo().is_some());
     assert!(beam.delassus().setup_times().w_lo_s > 0.0);
     assert!(sample.w_condition_estimate() < fricont::problem::AUTO_CONDITION);
-    assert!(!sample.extended_precision() && sample.delassus().w_lo().is_none());
-    assert_eq!(sample.delassus().setup_times().w_lo_s, 0.0);
+    assert!(sample.extended_precision() && sample.delassus().w_lo().is_some());
+    let rect = generate(&RectSpec {
+        nx: 121,
+        ny: 81,
+        ..RectSpec::press_shear()
+    })
+    .expect("generate");
+    let rect = build(&rect, ExtendedPrecision::Auto);
+    assert!(rect.w_condition_estimate() < fricont::problem::AUTO_CONDITION);
+    assert!(!rect.extended_precision() && rect.delassus().w_lo().is_none());
+    assert_eq!(rect.delassus().setup_times().w_lo_s, 0.0);
 }
 
 /// The condition estimate against the eigenvalues of W (nalgebra's symmetric
