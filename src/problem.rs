@@ -407,7 +407,8 @@ pub const AUTO_COST_FLOPS: f64 = 1e11;
 
 /// [`ExtendedPrecision::Auto`] refines whatever W's condition where the refinement's
 /// estimated floating-point operations are at most this (2e8, about 0.05 s on one core:
-/// the repository's sample, n = 1320 and p = 30, needs about 6e7). Even a
+/// the repository's sample, n = 1320 and p = 30, is below it; a 121 × 81 rectangle with
+/// p = 120 is not). Even a
 /// well-conditioned W, condensed in double, carries errors of κ(A) ε in its entries, and
 /// transitions where a guard crosses zero at a shallow angle amplify them and the
 /// trace's own rounding: on finite-element meshes of 12 to 37 × 1 to 3 elements with
