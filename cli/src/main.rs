@@ -131,7 +131,9 @@ struct TraceArgs {
     threads: usize,
     /// Carry W and the condensed loads beyond double precision (mixed-precision
     /// refinement with the factor of A, for slender bodies whose W is ill-conditioned):
-    /// auto when the condition estimate of W exceeds 1e7 and the cost is moderate.
+    /// auto where the refinement is cheap (at most 2e8 flops: small problems, whatever W's
+    /// condition), or where the condition estimate of W exceeds 1e7 and the cost is
+    /// moderate.
     #[arg(long, value_enum, default_value_t = Extended::Auto)]
     extended_precision: Extended,
     /// Write the JSON report to this file (every key: docs/json-report.md). The file is
