@@ -170,13 +170,18 @@ struct PieceSolves<'a> {
 
 impl<'a> PieceSolves<'a> {
     /// Starting from `seed` (a factorisation to update, e.g. the path's current one) when
-    /// given.
-    fn new(c: &'a PieceConstants<'a>, w: MatRef<'a, f64>, seed: Option<UpdatedLu>) -> Self {
+    /// given. `w_row_sums`: W's absolute row sums ([`crate::problem::Problem::w_row_sums`]).
+    fn new(
+        c: &'a PieceConstants<'a>,
+        w: MatRef<'a, f64>,
+        w_row_sums: &[f64],
+        seed: Option<UpdatedLu>,
+    ) -> Self {
         Self {
             c,
             w,
             lu: seed,
-            row_bound: update::row_bound(c, w),
+            row_bound: update::row_bound(c, w_row_sums),
         }
     }
 
@@ -468,27 +473,17 @@ pub(crate) fn solve_with_frozen(
     let c = PieceConstants::of(problem);
     let w = problem.delassus().w();
     let m = 2 * c.p;
-    let mut pieces = PieceSolves::new(&c, w, seed);
+    let w_row_sums = problem.w_row_sums();
+    let mut pieces = PieceSolves::new(&c, w, w_row_sums, seed);
     let lam0 = guess.map(|g| g.to_vec()).unwrap_or_else(|| vec![0.0; m]);
     let mut notes = Vec::new();
-    // Damped Newton first (its line search keeps it near its start, so on a problem with
-    // several solutions at α it finds the same one whatever the rounding), then, where it
-    // creeps, the active-set iteration from its iterate, then Newton again.
-    let (lam, ok, msg) = newton(&mut pieces, qg, lam0, 20, fr);
-    if ok {
-        return Ok(lam);
-    }
-    notes.push(msg);
-    let (lam, ok, msg) = active_set(&mut pieces, qg, lam, 100, fr);
-    if ok {
-        return Ok(lam);
-    }
-    notes.push(msg);
-    let (lam, ok, msg) = newton(&mut pieces, qg, lam, 200, fr);
-    if ok {
-        return Ok(lam);
-    }
-    notes.push(msg);
+    let lam = match newton_active_newton(&mut pieces, qg, lam0, [20, 100, 200], fr) {
+        Ok(lam) => return Ok(lam),
+        Err((lam, msgs)) => {
+            notes.extend(msgs);
+            lam
+        }
+    };
     // Newton stalls where its merit function is not smooth (classes change): a few block
     // Gauss-Seidel sweeps move the iterate off such a kink, and Newton resumes from there.
     // Rounds of both before the long Gauss-Seidel run below (each sweep is O(m²)).
@@ -518,7 +513,7 @@ pub(crate) fn solve_with_frozen(
         }
         notes.push(msg);
     }
-    match friction_continuation(&c, w, qg, fr) {
+    match friction_continuation(&c, w, w_row_sums, qg, fr) {
         Ok(lam) => return Ok(lam),
         Err(msg) => notes.push(msg),
     }
@@ -528,9 +523,40 @@ pub(crate) fn solve_with_frozen(
     })
 }
 
+/// The solver's first stages: damped Newton (its line search keeps it near its start, so
+/// on a problem with several solutions at α it finds the same one whatever the rounding),
+/// then, where it creeps, the active-set iteration from its iterate, then Newton again,
+/// with at most `iters` iterations each. The solution, or the last iterate with each
+/// stage's message.
+fn newton_active_newton(
+    pieces: &mut PieceSolves<'_>,
+    qg: &[f64],
+    lam0: Vec<f64>,
+    iters: [usize; 3],
+    fr: Frozen<'_>,
+) -> std::result::Result<Vec<f64>, (Vec<f64>, Vec<String>)> {
+    let mut notes = Vec::new();
+    let (lam, ok, msg) = newton(pieces, qg, lam0, iters[0], fr);
+    if ok {
+        return Ok(lam);
+    }
+    notes.push(msg);
+    let (lam, ok, msg) = active_set(pieces, qg, lam, iters[1], fr);
+    if ok {
+        return Ok(lam);
+    }
+    notes.push(msg);
+    let (lam, ok, msg) = newton(pieces, qg, lam, iters[2], fr);
+    if ok {
+        return Ok(lam);
+    }
+    notes.push(msg);
+    Err((lam, notes))
+}
+
 /// Last resort: continuation in the friction coefficients, `F_i(t) = t F_i` for t from 0
-/// to 1, each step's solve (damped Newton, then the active-set iteration, then Newton)
-/// started from the last one's solution. With large friction the damped Newton can stall
+/// to 1, each step's solve ([`newton_active_newton`]) started from the last one's
+/// solution. With large friction the damped Newton can stall
 /// at a stationary point of its merit function that is no solution (found on random
 /// problems with F up to 5: 3 starts in 6000), while the frictionless problem (a
 /// monotone complementarity problem in the normal forces) is solved from zero forces,
@@ -539,23 +565,15 @@ pub(crate) fn solve_with_frozen(
 fn friction_continuation(
     c: &PieceConstants,
     w: MatRef<'_, f64>,
+    w_row_sums: &[f64],
     qg: &[f64],
     fr: Frozen<'_>,
 ) -> std::result::Result<Vec<f64>, String> {
     let solve_at = |t: f64, lam0: Vec<f64>| -> Option<Vec<f64>> {
         let f: Vec<f64> = c.friction.iter().map(|x| x * t).collect();
         let ct = PieceConstants { friction: &f, ..*c };
-        let mut pieces = PieceSolves::new(&ct, w, None);
-        let (l, ok, _) = newton(&mut pieces, qg, lam0, 50, fr);
-        if ok {
-            return Some(l);
-        }
-        let (l, ok, _) = active_set(&mut pieces, qg, l, 100, fr);
-        if ok {
-            return Some(l);
-        }
-        let (l, ok, _) = newton(&mut pieces, qg, l, 50, fr);
-        ok.then_some(l)
+        let mut pieces = PieceSolves::new(&ct, w, w_row_sums, None);
+        newton_active_newton(&mut pieces, qg, lam0, [50, 100, 50], fr).ok()
     };
     let (mut t, mut h) = (0.0, 0.25);
     let mut lam = solve_at(0.0, vec![0.0; 2 * c.p])

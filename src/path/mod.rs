@@ -246,8 +246,6 @@ pub struct Path {
     updater: RefCell<Option<UpdatedLu>>,
     /// Fresh factorisations of a base piece matrix so far.
     refactorisations: Cell<usize>,
-    /// Bound on the row sums of any piece matrix, computed on first use.
-    row_bound: Cell<Option<f64>>,
     /// The last few `d = q − (g, 0) + W λ` with their (α, λ): every candidate piece at a
     /// transition point needs the point's, and the ratio test on the piece taken needs
     /// that of the piece's own point (primed when it was solved for).
@@ -671,7 +669,6 @@ impl Path {
             trace: None,
             updater: RefCell::new(None),
             refactorisations: Cell::new(0),
-            row_bound: Cell::new(None),
             gaps_cache: RefCell::new(Vec::new()),
             tol_cache: RefCell::new(None),
             graph_step: Cell::new(None),
@@ -954,12 +951,7 @@ impl Path {
 
     /// Bound on the absolute row sums of every piece matrix (for residual checks).
     fn row_bound(&self) -> f64 {
-        if let Some(b) = self.row_bound.get() {
-            return b;
-        }
-        let b = update::row_bound(&self.consts(), self.problem.delassus().w());
-        self.row_bound.set(Some(b));
-        b
+        update::row_bound(&self.consts(), self.problem.w_row_sums())
     }
 
     /// The path moves onto a piece: later pieces are updated from its factorisation.

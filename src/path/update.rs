@@ -763,14 +763,11 @@ fn residuals(
 }
 
 /// The largest absolute row sum of any piece matrix in `r0` units:
-/// `max(r0 ‖W‖∞, 1 + max F)`.
-pub(crate) fn row_bound(c: &PieceConstants<'_>, w: MatRef<'_, f64>) -> f64 {
+/// `max(r0 ‖W‖∞, 1 + max F)`, from W's absolute row sums
+/// ([`crate::problem::Problem::w_row_sums`]; O(m)).
+pub(crate) fn row_bound(c: &PieceConstants<'_>, w_row_sums: &[f64]) -> f64 {
     let c = &equilibrated(c);
-    let m = w.nrows();
-    let mut wn = 0.0f64;
-    for i in 0..m {
-        wn = wn.max((0..m).map(|j| w[(i, j)].abs()).sum());
-    }
+    let wn = w_row_sums.iter().fold(0.0f64, |a, &b| a.max(b));
     let fmax = c.friction.iter().fold(0.0f64, |a, &b| a.max(b));
     (c.r * wn).max(1.0 + fmax)
 }
