@@ -196,6 +196,21 @@ fn loads_with_periods_dividing_the_first_step_lose_no_excursion() {
     }
 }
 
+/// The general load `f(α) = f0 + A sin(50 α) f1` of a finite-element case (f itself,
+/// without a derivative).
+fn sine_shear_general(data: &common::Data, amp: f64) -> Load {
+    let (g0, g1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
+    let n = g0.len();
+    let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+        let s = amp * (50.0 * al).sin();
+        for ((o, a), b) in out.iter_mut().zip(&g0).zip(&g1) {
+            *o = a + s * b;
+        }
+        Ok(())
+    });
+    Load::general(n, f, None)
+}
+
 /// A finite-element mesh under `f(α) = f0 + A sin(50 α) f1` over three periods: every
 /// transition point of the affine path with |φ| < A is met six times (up and down in each
 /// period), at the α where A sin(50 α) equals it. Reference: the same mesh traced under
@@ -234,15 +249,6 @@ fn finite_element_sine_shear_finds_every_transition() {
         }
         want.sort_by(|x, y| x.0.total_cmp(&y.0));
         let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
-        let n = f0.len();
-        let (g0, g1) = (f0.clone(), f1.clone());
-        let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
-            let s = amp * (50.0 * al).sin();
-            for ((o, a), b) in out.iter_mut().zip(&g0).zip(&g1) {
-                *o = a + s * b;
-            }
-            Ok(())
-        });
         let weights = Box::new(
             move |al: f64, w: &mut [f64], dw: &mut [f64]| -> Result<(), LoadFailure> {
                 w[0] = 1.0;
@@ -253,7 +259,7 @@ fn finite_element_sine_shear_finds_every_transition() {
             },
         );
         let loads = [
-            ("general", Load::general(n, f, None)),
+            ("general", sine_shear_general(data, amp)),
             ("basis", Load::basis(vec![f0, f1], weights).unwrap()),
         ];
         for (name, load) in loads {
@@ -319,19 +325,10 @@ fn general_load_transitions_to_the_rounding_of_the_guards() {
             .iter()
             .map(|e| e.alpha)
             .collect();
-        let (g0, g1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
-        let n = g0.len();
-        let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
-            let s = amp * (50.0 * al).sin();
-            for ((o, a), b) in out.iter_mut().zip(&g0).zip(&g1) {
-                *o = a + s * b;
-            }
-            Ok(())
-        });
         let problem = Arc::new(data.problem());
         let mut path = Path::new(
             problem,
-            Load::general(n, f, None),
+            sine_shear_general(data, amp),
             PathOptions::window(a0, a1),
         )
         .unwrap();
