@@ -33,6 +33,7 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Accum, Conj, Mat, MatMut, MatRef, Par, Side};
 
 use crate::dd::{Dd, two_prod, two_sum};
+use crate::dense::inf_norm;
 use crate::error::{Error, Result, try_vec, try_zeros};
 use crate::problem::CsrMatrix;
 
@@ -1109,7 +1110,6 @@ impl Delassus {
             self.solve_scaled(MatMut::from_column_major_slice_mut(r, n, k))?;
             let mut more = false;
             for c in 0..k {
-                let (mut dn, mut xn) = (0.0f64, 0.0f64);
                 for i in c * n..(c + 1) * n {
                     let s = Dd {
                         hi: x[i],
@@ -1117,9 +1117,10 @@ impl Delassus {
                     }
                     .add_f64(r[i]);
                     (x[i], x_lo[i]) = (s.hi, s.lo);
-                    dn = dn.max(r[i].abs());
-                    xn = xn.max(x[i].abs());
                 }
+                // (NaN-sticky norms: a NaN correction is a divergence too)
+                let dn = inf_norm(&r[c * n..(c + 1) * n]);
+                let xn = inf_norm(&x[c * n..(c + 1) * n]);
                 if !dn.is_finite() {
                     return Err(Error::Numerical(
                         "the refinement of A^-1 B^T diverged (A too ill-conditioned for refinement in double)".into(),

@@ -224,6 +224,18 @@ pub(crate) fn llt_lower(a: MatRef<'_, f64>) -> Result<Mat<f64>, LltError> {
     Ok(l)
 }
 
+/// `max_i |v_i|` (0 for an empty `v`), NaN when some `v_i` is NaN: a residual or a
+/// solution with a NaN in it never passes for small (`f64::max` alone skips a NaN).
+pub(crate) fn inf_norm(v: &[f64]) -> f64 {
+    v.iter().fold(0.0f64, |m, x| {
+        if m.is_nan() || x.is_nan() {
+            f64::NAN
+        } else {
+            m.max(x.abs())
+        }
+    })
+}
+
 /// `Σ a_i b_i` in eight independent lanes, compiled for the machine's vector instructions
 /// by faer's dispatch (a plain `.sum()` is one sequential chain of additions that the
 /// compiler may not reorder, about one addition per cycle).

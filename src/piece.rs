@@ -710,7 +710,7 @@ pub fn residuals(
 ) -> Vec<f64> {
     let n = problem.n();
     let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
-    let inf = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let inf = crate::dense::inf_norm;
     // Terms near the end of the range of doubles (a load of 1e308, u of 1e308) would
     // overflow in the sums below: u, f, λ and g of each point are multiplied by a power of
     // two σ first, which does not change H / scale (H is homogeneous of degree one in

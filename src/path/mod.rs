@@ -20,6 +20,7 @@ use advance::Exit;
 use std::sync::Arc;
 
 use crate::class::Class;
+use crate::dense::inf_norm;
 use crate::error::{Error, Result};
 use crate::load::{BoundLoad, Load, LoadSnapshot};
 use crate::piece::{DenseLu, Guard, PieceConstants, PieceLu, displacement_gaps, shift_gap};
@@ -615,10 +616,6 @@ fn near_overflow(pt: &Point) -> String {
     } else {
         String::new()
     }
-}
-
-fn inf_norm(v: &[f64]) -> f64 {
-    v.iter().fold(0.0f64, |m, x| m.max(x.abs()))
 }
 
 /// Largest number of neighbouring pieces enumerated at one transition point (the product

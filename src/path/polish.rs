@@ -208,8 +208,8 @@ impl Refiner<'_> {
             let wdx = mat_mul(self.w, &dxs.iter().map(|v| &v[..]).collect::<Vec<_>>());
             for ((&j, dx), wdx) in active.iter().zip(&dxs).zip(wdx) {
                 let (x, d) = &mut xs[j];
-                let size = x.hi.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-                let step = dx.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+                let size = inf_norm(&x.hi);
+                let step = inf_norm(dx);
                 // The guess is a double-precision solution: a correction beyond ROUGH of
                 // it means a piece matrix too ill-conditioned for refinement in double
                 // (its solves amplify rounding to that size), not a better point.
@@ -261,12 +261,9 @@ pub(super) struct RefinedPiece {
 /// larger move means a piece whose point is ill-determined, and the double point, found
 /// with the tracer's own checks, is kept.
 pub(super) fn near(lam2: &[f64], lam: &[f64]) -> bool {
-    let big = lam.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let dl = lam2
-        .iter()
-        .zip(lam)
-        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
-    dl <= NEAR * big
+    let dl: Vec<f64> = lam2.iter().zip(lam).map(|(x, y)| x - y).collect();
+    // (a NaN anywhere makes the norms NaN: not near)
+    inf_norm(&dl) <= NEAR * inf_norm(lam)
 }
 
 impl Path {
