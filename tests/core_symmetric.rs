@@ -209,3 +209,103 @@ fn mirror_pairs_with_centre_node() {
         "{st:?}"
     );
 }
+
+/// Mirror-symmetric finite-element bodies ([`common::symmetric_fe_case`]): W comes from
+/// the condensation of A, so it is mirror-symmetric only to rounding, and no rounding error
+/// may decide a class (SPEC §3). Checked on every case:
+/// - each event of a node off the axis has its mirror image: the mirrored node, the same
+///   α to 1e-9, the classes mirrored (S+ and S− swap);
+/// - the centre node never enters slip (on the symmetric path its λt is 0);
+/// - against the independent reference tracer of `tests/common/reference.rs` (dense, a
+///   fresh factorisation per piece, its own condensation): the same events to 1e-8 up to
+///   where fricont stops; a stop is at a non-smooth bifurcation, where the reference
+///   either stops too (several continuations fit) or goes on along one branch, its next
+///   transition at the same α.
+#[test]
+fn mirror_symmetric_finite_element_bodies() {
+    use common::reference::{Condensed, compare_events, compare_with_fricont};
+    let mirror = |c: Class| match c {
+        Class::SlipPlus => Class::SlipMinus,
+        Class::SlipMinus => Class::SlipPlus,
+        c => c,
+    };
+    let (mut windows, mut stops, mut pairs) = (0, 0, 0);
+    for seed in 0..30u64 {
+        let mut rng = common::Rng::new(seed);
+        let nx = 2 * (2 + rng.int(0, 11)) + (seed % 2) as usize;
+        let ny = rng.int(1, 4);
+        let friction = [0.1, 0.3, 0.8, 1.5, 3.0, 5.0][rng.int(0, 5)];
+        let case = common::symmetric_fe_case(seed, nx, ny, friction);
+        let data = &case.data;
+        let ctx = format!("seed {seed} (nx = {nx}, ny = {ny}, F = {friction})");
+        let c = compare_with_fricont(
+            &Condensed::from_data(data),
+            Arc::new(data.problem()),
+            data.f0.as_slice(),
+            data.f1.as_slice(),
+            case.a0,
+            case.a1,
+            1e-8,
+            &mut |_, _| {},
+        );
+        assert!(
+            c.start_diff <= 1e-8,
+            "{ctx}: start λ differ by {:e}",
+            c.start_diff
+        );
+        let ev = &c.fricont;
+        for &(al, i, from, to) in ev {
+            if 2 * i == nx {
+                assert!(
+                    !matches!(to, Class::SlipPlus | Class::SlipMinus),
+                    "{ctx}: the centre node enters {to} at α = {al}"
+                );
+                continue;
+            }
+            assert!(
+                ev.iter().any(|&(b, j, f, t)| j == nx - i
+                    && (b - al).abs() <= 1e-9 * al.abs().max(1.0)
+                    && (f, t) == (mirror(from), mirror(to))),
+                "{ctx}: node {} {from} -> {to} at α = {al} has no mirror image",
+                i + 1
+            );
+            pairs += 1;
+        }
+        let want: Vec<common::reference::Ev> = c
+            .reference
+            .events
+            .iter()
+            .map(|e| (e.alpha, e.node, e.from, e.to))
+            .collect();
+        let (end_alpha, reason) = &c.fricont_end;
+        match reason.as_str() {
+            "window" => {
+                assert!(c.reference.end.is_ok(), "{ctx}: {:?}", c.reference.end);
+                compare_events(ev, &want, 1e-8).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+                windows += 1;
+            }
+            "bifurcation" => {
+                assert!(
+                    want.len() >= ev.len(),
+                    "{ctx}: the reference stopped earlier"
+                );
+                compare_events(ev, &want[..ev.len()], 1e-8)
+                    .unwrap_or_else(|e| panic!("{ctx}: {e}"));
+                let next = want.get(ev.len()).map_or(c.reference.end_alpha, |e| e.0);
+                assert!(
+                    (next - end_alpha).abs() <= 1e-8 * end_alpha.abs().max(1.0),
+                    "{ctx}: fricont stops at a bifurcation at α = {end_alpha}, the reference \
+                     goes on to α = {next} ({:?})",
+                    c.reference.end
+                );
+                stops += 1;
+            }
+            r => panic!("{ctx}: fricont ends with {r} at α = {end_alpha}"),
+        }
+    }
+    eprintln!("{windows} windows, {stops} bifurcation stops, {pairs} mirrored events");
+    assert!(
+        windows >= 10 && stops >= 2 && pairs >= 200,
+        "{windows} {stops} {pairs}"
+    );
+}

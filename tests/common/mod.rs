@@ -1046,16 +1046,17 @@ pub fn symmetric_case(seed: u64, centre: bool) -> Case {
     Case { seed, data, a0, a1 }
 }
 
-/// A small finite-element case (independent of `src/gen.rs`): plane-strain Q1 elements
-/// (E = 1, ν = 0.3, 2×2 Gauss) on an `nx × ny` grid of the rectangle (0, L) × (0, H), the
-/// left edge clamped (its dofs eliminated), the bottom nodes right of the corner in
-/// contact with a rigid foundation (`N u = −u_y`, `T u = u_x`, so p = nx), a top
-/// pressure plus random perturbations as f0, a random top shear/lift and right-edge
-/// traction as f1, friction `friction` at every node.
-pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
-    let mut rng = Rng::new(seed.wrapping_add(0xFE));
-    let (lx, ly) = (rng.range(1.0, 3.0), rng.range(0.5, 2.0));
-    let (hx, hy) = (lx / nx as f64, ly / ny as f64);
+/// The stiffness (n × n) of plane-strain Q1 elements (E = 1, ν = 0.3, 2×2 Gauss) of size
+/// `hx × hy` on an `nx × ny` grid of elements, node (i, j) at (i hx, j hy); `dof(i, j, k)`
+/// numbers the free dofs (k = 0: x, 1: y), None for a clamped one.
+fn assemble_q1(
+    nx: usize,
+    ny: usize,
+    hx: f64,
+    hy: f64,
+    n: usize,
+    dof: impl Fn(usize, usize, usize) -> Option<usize>,
+) -> DMatrix<f64> {
     let (e, nu) = (1.0, 0.3);
     let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
     let d = [
@@ -1090,17 +1091,6 @@ pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
             }
         }
     }
-    // free dofs: nodes with i ≥ 1
-    let node = |i: usize, j: usize| j * (nx + 1) + i;
-    let dof = |i: usize, j: usize, k: usize| -> Option<usize> {
-        if i == 0 {
-            None
-        } else {
-            Some(2 * (j * nx + (i - 1)) + k)
-        }
-    };
-    let _ = node;
-    let n = 2 * nx * (ny + 1);
     let mut a = DMatrix::zeros(n, n);
     for ei in 0..nx {
         for ej in 0..ny {
@@ -1118,6 +1108,29 @@ pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
             }
         }
     }
+    a
+}
+
+/// A small finite-element case (independent of `src/gen.rs`): plane-strain Q1 elements
+/// (E = 1, ν = 0.3, 2×2 Gauss) on an `nx × ny` grid of the rectangle (0, L) × (0, H), the
+/// left edge clamped (its dofs eliminated), the bottom nodes right of the corner in
+/// contact with a rigid foundation (`N u = −u_y`, `T u = u_x`, so p = nx), a top
+/// pressure plus random perturbations as f0, a random top shear/lift and right-edge
+/// traction as f1, friction `friction` at every node.
+pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
+    let mut rng = Rng::new(seed.wrapping_add(0xFE));
+    let (lx, ly) = (rng.range(1.0, 3.0), rng.range(0.5, 2.0));
+    let (hx, hy) = (lx / nx as f64, ly / ny as f64);
+    // free dofs: nodes with i ≥ 1
+    let dof = |i: usize, j: usize, k: usize| -> Option<usize> {
+        if i == 0 {
+            None
+        } else {
+            Some(2 * (j * nx + (i - 1)) + k)
+        }
+    };
+    let n = 2 * nx * (ny + 1);
+    let mut a = assemble_q1(nx, ny, hx, hy, n, dof);
     let at = a.transpose();
     a = (a + at) * 0.5;
     let p = nx;
@@ -1167,6 +1180,71 @@ pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
         (4.0, -2.0)
     };
     Case { seed, data, a0, a1 }
+}
+
+/// A mirror-symmetric finite-element case: plane-strain Q1 elements (as [`fe_case`]) on
+/// an `nx × ny` grid of (0, L) × (0, H), the top edge clamped, every bottom node (i =
+/// 0..=nx, so p = nx + 1; a centre node when nx is even) on the rigid foundation; f0 a
+/// uniform downward push on every free node, f1 a symmetric side traction (outward
+/// `±s_x`, upward `s_y` on both sides) plus a symmetric vertical profile. Node i and
+/// node nx − i are mirror images (their t-directions opposite). Window [−1, 3].
+pub fn symmetric_fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
+    let mut rng = Rng::new(seed.wrapping_add(0x5F));
+    let (lx, ly) = (rng.range(1.0, 4.0), rng.range(0.3, 2.0));
+    let (hx, hy) = (lx / nx as f64, ly / ny as f64);
+    // free dofs: nodes with j < ny (the top row clamped)
+    let dof = |i: usize, j: usize, k: usize| -> Option<usize> {
+        if j == ny {
+            None
+        } else {
+            Some(2 * (j * (nx + 1) + i) + k)
+        }
+    };
+    let n = 2 * (nx + 1) * ny;
+    let mut a = assemble_q1(nx, ny, hx, hy, n, dof);
+    let at = a.transpose();
+    a = (a + at) * 0.5;
+    let p = nx + 1;
+    let mut nm = DMatrix::zeros(p, n);
+    let mut tm = DMatrix::zeros(p, n);
+    for i in 0..=nx {
+        nm[(i, dof(i, 0, 1).unwrap())] = -1.0;
+        tm[(i, dof(i, 0, 0).unwrap())] = 1.0;
+    }
+    let mut f0 = DVector::zeros(n);
+    let mut f1 = DVector::zeros(n);
+    let cells = ((nx + 1) * ny) as f64;
+    let push = rng.range(0.01, 0.1) / cells;
+    let (sx, sy) = (rng.range(0.0, 0.2), rng.range(-0.1, 0.1));
+    let bump = rng.range(-0.05, 0.05);
+    for j in 0..ny {
+        for i in 0..=nx {
+            f0[dof(i, j, 1).unwrap()] -= push;
+            let xr = (i as f64 / nx as f64 - 0.5).abs();
+            f1[dof(i, j, 1).unwrap()] += bump * (1.0 - 2.0 * xr) / cells;
+        }
+        f1[dof(0, j, 0).unwrap()] -= sx / ny as f64;
+        f1[dof(nx, j, 0).unwrap()] += sx / ny as f64;
+        f1[dof(0, j, 1).unwrap()] += sy / ny as f64;
+        f1[dof(nx, j, 1).unwrap()] += sy / ny as f64;
+    }
+    let data = Data {
+        n,
+        p,
+        a,
+        nm,
+        tm,
+        friction: vec![friction; p],
+        gap: vec![0.0; p],
+        f0,
+        f1,
+    };
+    Case {
+        seed,
+        data,
+        a0: -1.0,
+        a1: 3.0,
+    }
 }
 
 /// An event with its full state (u by one back-solve, residual), as the tests read them;
