@@ -24,7 +24,7 @@ use common::reference::{
 };
 use common::{Brute, fe_case, fold_problem, mirror_pair, random_case, symmetric_case};
 use fricont::Class;
-use fricont_exchange::generator::{RectSpec, generate};
+use fricont_exchange::generator::{RectSpec, Side, Traction, generate};
 
 /// The brute-force piece containing `a0`, when it is unique (away from breakpoints).
 fn start_piece(br: &Brute, a0: f64) -> Option<&common::BrutePiece> {
@@ -309,6 +309,73 @@ fn slender(name: &str, spec: RectSpec, tol: f64) {
         "{name}: only {} events",
         r.events.len()
     );
+}
+
+/// Random rectangles against the reference, to 1e-8 (relative to max(1, |α|), the issue's
+/// acceptance): 8 to 67 × 2 to 9 nodes on sides of 0.5–8 × 0.1–3, friction 0.05 to 5, a
+/// uniform gap of either sign (up to 1e-3) on every third, a random linearly varying
+/// press (and shear) on the top as f0, random linear tractions on the top (and on the
+/// right side, every second) as f1, the window [−1, 2]. The same start, events and end;
+/// some of them fold.
+#[test]
+fn random_rectangles() {
+    let mut folds = 0;
+    for seed in 0..24u64 {
+        let mut rng = common::Rng::new(seed * 7919 + 17);
+        let t = |rng: &mut common::Rng| [rng.range(-0.01, 0.01), rng.range(-0.01, 0.01)];
+        let press = rng.range(0.002, 0.03);
+        let spec = RectSpec {
+            nx: rng.int(8, 67),
+            ny: rng.int(2, 9),
+            lx: rng.range(0.5, 8.0),
+            ly: rng.range(0.1, 3.0),
+            friction: [0.05, 0.3, 1.0, 2.0, 3.5, 5.0][rng.int(0, 5)],
+            gap: if seed % 3 == 0 {
+                rng.range(-1e-3, 1e-3)
+            } else {
+                0.0
+            },
+            load0: vec![Traction::linear(
+                Side::Top,
+                [rng.range(-0.01, 0.01), -press * rng.range(0.2, 1.0)],
+                [rng.range(-0.01, 0.01), -press],
+            )],
+            load1: {
+                let mut l = vec![Traction::linear(Side::Top, t(&mut rng), t(&mut rng))];
+                if seed % 2 == 0 {
+                    l.push(Traction::linear(Side::Right, t(&mut rng), t(&mut rng)));
+                }
+                l
+            },
+            alpha_start: -1.0,
+            alpha_end: 2.0,
+            ..RectSpec::press_shear()
+        };
+        let name = format!(
+            "seed {seed}: {} x {} nodes on {:.2} x {:.2}, F = {}, gap {:e}",
+            spec.nx, spec.ny, spec.lx, spec.ly, spec.friction, spec.gap
+        );
+        let case = generate(&spec).expect("generate");
+        let c = compare_with_fricont(
+            &condensed(&case),
+            Arc::new(case.problem(None).expect("problem")),
+            &case.f0,
+            &case.f1,
+            case.alpha_start,
+            case.alpha_end,
+            1e-8,
+            &mut no_progress(),
+        );
+        if let Err(e) = c.check(1e-8) {
+            panic!(
+                "{name}: fricont {} events, reference {}: {e}",
+                c.fricont.len(),
+                c.reference.events.len()
+            );
+        }
+        folds += c.folds.0;
+    }
+    assert!(folds > 0, "no fold among the rectangles");
 }
 
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.
