@@ -593,6 +593,12 @@ fn usage_errors() {
     );
     path.run().unwrap();
     assert!(path.end_reason().is_some());
+    // α must be finite (it used to give an empty list, as for an α never reached)
+    for a in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let e = no_panic("solutions_at a non-finite alpha", || path.solutions_at(a)).unwrap_err();
+        assert!(matches!(e, Error::InvalidParameter(_)), "{a}: {e:?}");
+    }
+    assert!(!path.solutions_at(0.5).unwrap().is_empty());
     // stepping an ended path does not panic
     let _ = no_panic("step after end", || path.step());
 }

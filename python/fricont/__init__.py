@@ -251,7 +251,8 @@ class Path:
     def solutions_at(self, alpha: float) -> list:
         """Every traced solution at ``alpha`` (several past a fold), as :class:`Solution`
         objects: one small solve on each stored piece whose alpha range contains it, plus a
-        back-solve for u."""
+        back-solve for u. Empty where the traced path never reached ``alpha``;
+        ``ValueError`` when ``alpha`` is not finite."""
         out = []
         for piece, st, continuum in self._core.solutions_at(float(alpha)):
             out.append(

@@ -76,6 +76,9 @@ def test_one_node_sticks_then_slips_at_the_hand_derived_alpha():
     assert sol.lambda_t[0] == pytest.approx(-0.5, abs=1e-14)
     assert sol.u[1] == pytest.approx(0.5, abs=1e-14)
     assert sol.classes == ("slip+",)
+    for bad in (float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="not finite"):
+            path.solutions_at(bad)
 
 
 def test_sample_events_equal_the_cli(sample, tmp_path):

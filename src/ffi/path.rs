@@ -1326,9 +1326,6 @@ pub unsafe extern "C" fn fricont_path_solutions_at(
         if count.is_null() {
             return Err(Failure::null("count"));
         }
-        if !alpha.is_finite() {
-            return Err(Failure::range(format!("alpha = {alpha} is not finite")));
-        }
         h.solutions.clear();
         let sols = h.started_mut()?.solutions_at(alpha)?;
         h.solutions = sols;

@@ -266,9 +266,14 @@ impl Path {
     /// otherwise (O(k m²) by an update of the path's current factorisation when the piece
     /// differs from it in k ≤ m/16 nodes, checked against the data; O(m³) by a fresh LU
     /// beyond that), plus one back-solve for u. Points shared by two pieces (transition
-    /// points) are reported once. Empty if the traced path never reached `alpha`. Errors: not started, load
-    /// failure.
+    /// points) are reported once. Empty if the traced path never reached `alpha`. Errors:
+    /// `alpha` not finite ([`Error::InvalidParameter`]), not started, load failure.
     pub fn solutions_at(&mut self, alpha: f64) -> Result<Vec<Solution>> {
+        if !alpha.is_finite() {
+            return Err(Error::InvalidParameter(format!(
+                "alpha = {alpha} is not finite"
+            )));
+        }
         let _pool = self.pool_scope();
         let pieces = self.trace_ref()?.pieces.clone();
         let m = 2 * self.problem.p();
