@@ -85,13 +85,26 @@ def _reraise(err: BaseException) -> BaseException:
     return err
 
 
+def _float64(name: str, v: Any) -> np.ndarray:
+    """``v`` as float64; ValueError for complex values with a nonzero imaginary part (numpy
+    would drop it with a warning only), the real part of complex values without one."""
+    a = np.asarray(v)
+    if np.iscomplexobj(a):
+        if np.any(a.imag != 0):
+            raise ValueError(
+                f"{name}: complex values with a nonzero imaginary part; expected real numbers"
+            )
+        a = a.real
+    return np.asarray(a, dtype=np.float64)
+
+
 def _csr(name: str, m: Any, shape: Optional[Tuple[int, int]] = None):
     """(shape, indptr int64, indices int64, data float64) of any scipy.sparse matrix or
     array (CSR, CSC, COO, ...; int32 or int64 indices) or dense array-like."""
     if _sp.issparse(m):
         c = _sp.csr_array(m)
     else:
-        d = np.asarray(m, dtype=np.float64)
+        d = _float64(name, m)
         if d.ndim != 2:
             raise ValueError(f"{name}: expected a 2-D matrix, got an array of shape {d.shape}")
         c = _sp.csr_array(d)
@@ -102,13 +115,12 @@ def _csr(name: str, m: Any, shape: Optional[Tuple[int, int]] = None):
         (int(c.shape[0]), int(c.shape[1])),
         np.ascontiguousarray(c.indptr, dtype=np.int64),
         np.ascontiguousarray(c.indices, dtype=np.int64),
-        np.ascontiguousarray(c.data, dtype=np.float64),
+        np.ascontiguousarray(_float64(name, c.data)),
     )
 
 
 def _vector(name: str, v: Any) -> np.ndarray:
-    a = np.ascontiguousarray(np.asarray(v, dtype=np.float64).ravel())
-    return a
+    return np.ascontiguousarray(_float64(name, v).ravel())
 
 
 @dataclass(frozen=True)
@@ -307,14 +319,14 @@ class Problem:
         n = _csr("N", N)
         t = _csr("T", T)
         p = n[0][0]
-        fr = np.asarray(friction, dtype=np.float64).ravel()
+        fr = _float64("friction", friction).ravel()
         if fr.size == 1:
             fr_list = [float(fr[0])]
         else:
             fr_list = [float(x) for x in fr]
             if len(fr_list) != p:
                 raise ValueError(f"friction has {len(fr_list)} values, expected 1 or p = {p}")
-        g = None if gap is None else [float(x) for x in np.asarray(gap, dtype=np.float64).ravel()]
+        g = None if gap is None else [float(x) for x in _float64("gap", gap).ravel()]
         try:
             if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
                 raise ValueError(f"threads = {threads!r}: expected an integer in 1..1024")
@@ -393,8 +405,20 @@ class Problem:
         if load is not None:
             if f0 is not None or f1 is not None:
                 raise ValueError("give either f0 and f1 (affine load) or load=, not both")
+            # (the returned vectors through _vector: a complex f is an error, not its real
+            # part with a warning)
+            def real(fn, name):
+                return None if fn is None else (lambda a: _vector(name, fn(a)))
+
             core = self._core.trace_general(
-                load, dload, int(n) if n is not None else self.n, win, a0, ms, h, monitor
+                real(load, "load"),
+                real(dload, "dload"),
+                int(n) if n is not None else self.n,
+                win,
+                a0,
+                ms,
+                h,
+                monitor,
             )
         else:
             if f0 is None or f1 is None:

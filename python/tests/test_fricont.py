@@ -313,3 +313,32 @@ def test_the_skfem_example_agrees_with_the_cli(tmp_path):
         case["f0"], case["f1"], window=(case["alpha_start"], case["alpha_end"]))
     assert_same_events(path.events, cli_events(tmp_path / "problem", tmp_path))
     assert f"{len(path.events)} events" in proc.stdout
+
+
+def test_complex_input_is_refused_unless_it_is_real():
+    # numpy drops an imaginary part with a warning only: fricont refuses it, and takes the
+    # real part of complex values whose imaginary parts are all zero.
+    A = sp.diags([2.0, 1.0]).tocsr()
+    N, T = [[1.0, 0.0]], [[0.0, 1.0]]
+    ref = fricont.Problem(A, N, T, friction=0.5).trace(
+        f0=[1.0, 0.0], f1=[0.0, 1.0], window=(0.0, 2.0)
+    )
+    with pytest.raises(ValueError, match="imaginary"):
+        fricont.Problem(A.astype(complex) * (1 + 1e-3j), N, T, friction=0.5)
+    with pytest.raises(ValueError, match="imaginary"):
+        fricont.Problem(np.diag([2.0, 1.0 + 1e-9j]), N, T, friction=0.5)
+    with pytest.raises(ValueError, match="imaginary"):
+        fricont.Problem(A, N, T, friction=0.5 + 0.1j)
+    prob = fricont.Problem(A.astype(complex), np.array(N, dtype=complex), T, friction=0.5 + 0j)
+    with pytest.raises(ValueError, match="imaginary"):
+        prob.trace(f0=[1.0, 1j], f1=[0.0, 1.0], window=(0.0, 2.0))
+    with pytest.raises(ValueError, match="imaginary"):
+        prob.trace(load=lambda a: np.array([1.0, a + 1e-6j]), window=(0.0, 2.0))
+    for path in (
+        prob.trace(f0=np.array([1.0, 0.0], dtype=complex), f1=[0.0, 1.0], window=(0.0, 2.0)),
+        prob.trace(load=lambda a: np.array([1.0, a], dtype=complex), window=(0.0, 2.0)),
+    ):
+        assert [(e.node, e.from_class, e.to_class) for e in path.events] == [
+            (e.node, e.from_class, e.to_class) for e in ref.events
+        ]
+        assert abs(path.events[0].alpha - 0.5) <= 1e-14
