@@ -310,8 +310,9 @@ class Problem:
     Duplicate entries (a COO matrix, or a CSR matrix without canonical format) are summed,
     as by every fricont interface (C, C++, Fortran, the CLI's Matrix Market files).
 
-    Raises ValueError (invalid data: dimensions, NaN/Inf, not symmetric, F < 0, r <= 0,
-    threads outside 1..1024) and NotPositiveDefinite (A not SPD, with the failing pivot; B rank-deficient).
+    Raises ValueError (invalid data: dimensions, NaN/Inf, complex values with a nonzero
+    imaginary part, not symmetric, F < 0, r <= 0, threads outside 1..1024) and
+    NotPositiveDefinite (A not SPD, with the failing pivot; B rank-deficient).
     """
 
     def __init__(self, A, N, T, friction=0.3, gap=None, r=None, storage="full", threads=1):
