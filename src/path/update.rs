@@ -634,21 +634,13 @@ impl UpdatedLu {
             })
             .collect();
         let c = &equilibrated(c);
-        let inf = inf_norm;
         let finish = |k: usize, solved: Vec<f64>, r: Vec<f64>, wx: Vec<f64>| {
             let x: Vec<f64> = match cols[k].guess {
                 Some((x0, _)) => x0.iter().zip(&solved).map(|(a, b)| a + b).collect(),
                 None => solved.clone(),
             };
-            let denom = row_bound * inf(&x) + inf(&full[k]);
-            // (a NaN denominator, from a NaN in x or b, makes rel NaN: refused below)
-            let rel = if denom > 0.0 || denom.is_nan() {
-                inf(&r) / denom
-            } else {
-                inf(&r)
-            };
             Checked {
-                rel: if rel.is_finite() { rel } else { f64::INFINITY },
+                rel: scaled_relative_residual(&r, &x, &full[k], row_bound),
                 x,
                 wx,
                 solved,
@@ -736,8 +728,20 @@ pub(crate) fn relative_residual(
     b: &[f64],
     row_bound: f64,
 ) -> f64 {
-    let denom = row_bound * inf_norm(x) + inf_norm(&scale_rhs(c, classes, b));
-    let num = inf_norm(&scale_rhs(c, classes, r));
+    scaled_relative_residual(
+        &scale_rhs(c, classes, r),
+        x,
+        &scale_rhs(c, classes, b),
+        row_bound,
+    )
+}
+
+/// `‖r‖∞ / (row_bound ‖x‖∞ + ‖b‖∞)` for r and b already in `r0` units (‖r‖∞ where the
+/// denominator is 0); ∞ where that is not finite, a NaN in r, x or b included (the norms
+/// are NaN then, see [`inf_norm`]).
+fn scaled_relative_residual(r: &[f64], x: &[f64], b: &[f64], row_bound: f64) -> f64 {
+    let denom = row_bound * inf_norm(x) + inf_norm(b);
+    let num = inf_norm(r);
     let rel = if denom > 0.0 || denom.is_nan() {
         num / denom
     } else {
@@ -771,9 +775,7 @@ fn residuals(
 /// ([`crate::problem::Problem::w_row_sums`]; O(m)).
 pub(crate) fn row_bound(c: &PieceConstants<'_>, w_row_sums: &[f64]) -> f64 {
     let c = &equilibrated(c);
-    let wn = w_row_sums.iter().fold(0.0f64, |a, &b| a.max(b));
-    let fmax = c.friction.iter().fold(0.0f64, |a, &b| a.max(b));
-    (c.r * wn).max(1.0 + fmax)
+    (c.r * inf_norm(w_row_sums)).max(1.0 + inf_norm(c.friction))
 }
 
 #[cfg(test)]
