@@ -178,12 +178,15 @@ pub(crate) struct BoundLoad {
     /// root, then the join at it), and each evaluation costs the user's callbacks and a
     /// solve with A.
     last_general: Option<GeneralEval>,
+    /// A general load's anchor `(f(α_a), q(α_a))` ([`Self::set_anchor`]).
+    anchor: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 /// A general load evaluated at `alpha`: `q(α)`, `q'(α)` and, where W was refined, the
 /// low part of q (see [`BoundLoad::general_q_lo`]).
 struct GeneralEval {
     alpha: f64,
+    f: Vec<f64>,
     q: Vec<f64>,
     dq: Vec<f64>,
     q_lo: Option<Vec<f64>>,
@@ -240,6 +243,7 @@ impl BoundLoad {
             weights_alpha: f64::NAN,
             recent_weights: Vec::new(),
             last_general: None,
+            anchor: None,
         })
     }
 
@@ -299,6 +303,26 @@ impl BoundLoad {
     pub(crate) fn general_q_lo(&self) -> Option<(&[f64], &[f64])> {
         let e = self.last_general.as_ref()?;
         Some((&e.q, e.q_lo.as_deref()?))
+    }
+
+    /// Anchors a general load at `alpha` (`None` drops the anchor; a no-op for other
+    /// loads): until it is dropped, [`Self::q`] condenses the change `f(α) − f(α_a)` and
+    /// adds it to `q(α_a)`. The rounding of q(α) is then proportional to that change:
+    /// smooth in α near α_a, where a fresh condensation at each α differs from the next
+    /// by `κ(A) ε ‖q‖`, noise that can exceed a slender body's guard thresholds. Errors:
+    /// those of [`Self::q`] at `alpha`.
+    pub(crate) fn set_anchor(&mut self, alpha: Option<f64>, del: &Delassus) -> Result<()> {
+        self.anchor = None;
+        self.last_general = None;
+        let (Some(alpha), Load::General { .. }) = (alpha, &self.load) else {
+            return Ok(());
+        };
+        self.q(alpha, del)?;
+        self.anchor = self
+            .last_general
+            .as_ref()
+            .map(|e| (e.f.clone(), e.q.clone()));
+        Ok(())
     }
 
     /// For a basis load: its condensed vectors `q_j`, so that `q(α) = Σ_j w_j(α) q_j`.
@@ -497,15 +521,26 @@ impl BoundLoad {
                             .collect()
                     }
                 };
-                // q and q' in one pass over the factor of A.
-                let mut qs = del.condense_many(&[&fv, &d])?;
+                // q and q' in one pass over the factor of A (with an anchor, q as
+                // q(α_a) plus the condensed change of f).
+                let change: Option<Vec<f64>> = self
+                    .anchor
+                    .as_ref()
+                    .map(|(fa, _)| fv.iter().zip(fa).map(|(a, b)| a - b).collect());
+                let mut qs = del.condense_many(&[change.as_deref().unwrap_or(&fv), &d])?;
                 let dq = qs.pop().expect("two columns");
-                let q = qs.pop().expect("two columns");
+                let mut q = qs.pop().expect("two columns");
+                if let Some((_, qa)) = &self.anchor {
+                    for (a, b) in q.iter_mut().zip(qa) {
+                        *a += b;
+                    }
+                }
                 // Where W was refined, q's low part too: the tracer refines its points
                 // under this load on q + q_lo.
                 let q_lo = del.condense_lo(&[&fv], &[&q])?.and_then(|mut v| v.pop());
                 self.last_general = Some(GeneralEval {
                     alpha,
+                    f: fv,
                     q: q.clone(),
                     dq: dq.clone(),
                     q_lo,

@@ -378,6 +378,90 @@ fn random_rectangles() {
     assert!(folds > 0, "no fold among the rectangles");
 }
 
+/// A general load in double alone on a moderately slender body (67 × 6 nodes on
+/// 2.82 × 0.115, κ(W) ≈ 9.7e5, which `auto` leaves in double): `f0 + 1.5 sin(500 α) f1`
+/// over two periods, `f(α)` itself condensed and solved for at each α. Every event must be
+/// the reference's affine event `f0 + φ f1` at φ = 1.5 sin(500 α), met four times (up
+/// and down in each period, the classes swapped on the way down), to 1e-9 in φ. Solved
+/// afresh at each α, the guards carried rounding of cond · ε of the whole load, different
+/// at each α: the march stopped loudly after 325 of the 664 events (the solutions at two
+/// α 2.3e-14 apart disagreed by 6.2e-13 on a guard whose threshold is 3.5e-13). Measured
+/// now: 4.3e-13 in α against the same load traced in extended precision.
+#[test]
+fn general_load_in_double_on_a_moderately_slender_body() {
+    let spec: RectSpec = serde_json::from_str(
+        r#"{"nx": 67, "ny": 6, "lx": 2.816478827916063, "ly": 0.11467220907561955,
+            "friction": 0.3,
+            "load0": [{"side": "top", "start": [0.006529728547488569, -0.005979787701059291],
+                       "end": [0.0007964457772528903, -0.011959575402118582]}],
+            "load1": [{"side": "top", "start": [-0.0020925322610123673, 0.006161412388091854],
+                       "end": [-0.00954923316172539, 0.0022156503811689727]},
+                      {"side": "right", "start": [-0.007249115492602159, 0.008818176316708665],
+                       "end": [0.004303542283064217, 0.0015691136377103398]}]}"#,
+    )
+    .expect("spec");
+    let case = generate(&spec).expect("generate");
+    let double = Arc::new(
+        case.builder()
+            .extended_precision(fricont::ExtendedPrecision::Off)
+            .build()
+            .expect("problem"),
+    );
+    let (amp, omega) = (1.5, 500.0);
+    let c = compare_with_fricont(
+        &condensed(&case),
+        double.clone(),
+        &case.f0,
+        &case.f1,
+        -amp,
+        amp,
+        1e-9,
+        &mut no_progress(),
+    );
+    // (in double alone: W's rounding moves its events by up to 1.0e-10)
+    c.check(1e-9)
+        .expect("the affine load against the reference");
+    // φ runs 0 → A → −A → A → −A → 0.
+    let aff = ref_events(&c.reference);
+    let up = |keep: &dyn Fn(f64) -> bool| -> Vec<Ev> {
+        aff.iter().filter(|e| keep(e.0)).copied().collect()
+    };
+    let down = || -> Vec<Ev> {
+        aff.iter()
+            .rev()
+            .map(|&(phi, node, from, to)| (phi, node, to, from))
+            .collect()
+    };
+    let mut want = up(&|phi| phi > 0.0);
+    want.extend(down());
+    want.extend(up(&|_| true));
+    want.extend(down());
+    want.extend(up(&|phi| phi < 0.0));
+    let (f0, f1) = (case.f0.clone(), case.f1.clone());
+    let f = move |a: f64, out: &mut [f64]| {
+        let s = amp * (omega * a).sin();
+        for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+            *o = x + s * y;
+        }
+        Ok::<(), fricont::load::LoadFailure>(())
+    };
+    let load = fricont::Load::general(case.f0.len(), Box::new(f), None);
+    let (a0, a1) = (0.0, 4.0 * std::f64::consts::PI / omega);
+    let opts = fricont::PathOptions::window(a0, a1);
+    let mut path = fricont::Path::new(double, load, opts).expect("path");
+    path.start(a0, None).expect("start");
+    path.run()
+        .unwrap_or_else(|e| panic!("after {} events: {e}", path.events().len()));
+    assert_eq!(path.end_reason().map(|r| r.name()), Some("window"));
+    let got: Vec<Ev> = path
+        .events()
+        .iter()
+        .map(|e| (amp * (omega * e.alpha).sin(), e.node, e.from, e.to))
+        .collect();
+    let worst = compare_events(&got, &want, 1e-9).unwrap_or_else(|e| panic!("{e}"));
+    eprintln!("{} events, worst {worst:e} in φ", got.len());
+}
+
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.
 fn strip(p: usize) -> RectSpec {
     RectSpec {

@@ -126,6 +126,17 @@ impl BasisSolutions {
     }
 }
 
+/// A general load's point at the entry of a graph piece (see [`Path::exit_graph`]):
+/// `q(α_e)`, λ and `d = W λ + q − (g, 0)` there.
+#[derive(Clone)]
+struct Entry {
+    q: Vec<f64>,
+    lam: Vec<f64>,
+    d: Vec<f64>,
+}
+
+type EntryCell = std::cell::RefCell<Option<Entry>>;
+
 impl Path {
     /// The [`BasisSolutions`] of the current piece under a basis load, solved by updates of
     /// the path's factorisation. None for other loads, for the fresh-factorisation tracer
@@ -480,7 +491,34 @@ impl Path {
 
     /// Exit of a graph piece under a nonlinear load: march in α with steps that the
     /// guards' Hermite interpolants certify free of double crossings, then Brent.
+    ///
+    /// A general load in double precision is evaluated relative to the piece's entry
+    /// point: `q(α) = q(α_e) + (condensed f(α) − f(α_e))` ([`BoundLoad::set_anchor`]) and
+    /// `λ(α) = λ(α_e) + M_S⁻¹ (b(q(α)) − b(q(α_e)))`, d likewise. Solved afresh at each α,
+    /// λ and d carry rounding of `cond · ε` of the whole load, different at each α: on a
+    /// slender body that noise exceeded the guards' thresholds, so that the march stopped
+    /// (the guards at α and α + 1e-14 disagreed) or roots moved by 1e-9. Relative to the
+    /// entry, the rounding is proportional to the change of the load since the entry:
+    /// smooth in α, and small near the roots that matter. (Under extended precision each
+    /// point is refined in double-double instead.)
     pub(super) fn exit_graph(&mut self, cur: &CurrentPiece) -> Result<Exit> {
+        let anchored = self.load.basis_vectors().is_none()
+            && !self.load.is_affine()
+            && !self.problem.extended_precision();
+        if !anchored {
+            return self.exit_graph_on(cur, None);
+        }
+        let problem = self.problem.clone();
+        self.load.set_anchor(Some(cur.alpha), problem.delassus())?;
+        let entry = std::cell::RefCell::new(None);
+        let out = self.exit_graph_on(cur, Some(&entry));
+        self.load.set_anchor(None, problem.delassus())?;
+        out
+    }
+
+    /// [`Self::exit_graph`], with `entry` for a general load evaluated relative to the
+    /// entry point (set by the first evaluation, at the entry).
+    fn exit_graph_on(&mut self, cur: &CurrentPiece, entry: Option<&EntryCell>) -> Result<Exit> {
         let m = 2 * self.problem.p();
         let dir = if cur.t[m] > 0.0 { 1.0 } else { -1.0 };
         let (lo, hi) = self.window();
@@ -542,6 +580,30 @@ impl Path {
                         [lam, d, t, rate]
                     } else {
                         solve(this, &qg, dq)
+                    }
+                }
+                _ if let Some(cell) = entry => {
+                    let known = cell.borrow().clone();
+                    match known {
+                        // λ and d at the entry plus the solution for the change of q.
+                        Some(e) => {
+                            let change: Vec<f64> =
+                                at.q.iter().zip(&e.q).map(|(a, b)| a - b).collect();
+                            let [dl, dd, t, rate] = solve(this, &change, dq);
+                            let add = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                                a.iter().zip(b).map(|(x, y)| x + y).collect()
+                            };
+                            [add(&e.lam, &dl), add(&e.d, &dd), t, rate]
+                        }
+                        None => {
+                            let out = solve(this, &qg, dq);
+                            *cell.borrow_mut() = Some(Entry {
+                                q: at.q.clone(),
+                                lam: out[0].clone(),
+                                d: out[1].clone(),
+                            });
+                            out
+                        }
                     }
                 }
                 _ => {
