@@ -378,49 +378,29 @@ fn random_rectangles() {
     assert!(folds > 0, "no fold among the rectangles");
 }
 
-/// A general load in double alone on a moderately slender body (67 × 6 nodes on
-/// 2.82 × 0.115, κ(W) ≈ 9.7e5, which `auto` leaves in double): `f0 + 1.5 sin(500 α) f1`
-/// over two periods, `f(α)` itself condensed and solved for at each α. Every event must be
-/// the reference's affine event `f0 + φ f1` at φ = 1.5 sin(500 α), met four times (up
-/// and down in each period, the classes swapped on the way down), to 1e-9 in φ. Solved
-/// afresh at each α, the guards carried rounding of cond · ε of the whole load, different
-/// at each α: the march stopped loudly after 325 of the 664 events (the solutions at two
-/// α 2.3e-14 apart disagreed by 6.2e-13 on a guard whose threshold is 3.5e-13). Measured
-/// now: 4.3e-13 in α against the same load traced in extended precision.
-#[test]
-fn general_load_in_double_on_a_moderately_slender_body() {
-    let spec: RectSpec = serde_json::from_str(
-        r#"{"nx": 67, "ny": 6, "lx": 2.816478827916063, "ly": 0.11467220907561955,
-            "friction": 0.3,
-            "load0": [{"side": "top", "start": [0.006529728547488569, -0.005979787701059291],
-                       "end": [0.0007964457772528903, -0.011959575402118582]}],
-            "load1": [{"side": "top", "start": [-0.0020925322610123673, 0.006161412388091854],
-                       "end": [-0.00954923316172539, 0.0022156503811689727]},
-                      {"side": "right", "start": [-0.007249115492602159, 0.008818176316708665],
-                       "end": [0.004303542283064217, 0.0015691136377103398]}]}"#,
-    )
-    .expect("spec");
-    let case = generate(&spec).expect("generate");
-    let double = Arc::new(
-        case.builder()
-            .extended_precision(fricont::ExtendedPrecision::Off)
-            .build()
-            .expect("problem"),
-    );
-    let (amp, omega) = (1.5, 500.0);
+/// Traces `f0 + A sin(ω α) f1` over two periods from α = 0 as a general load (`f(α)`
+/// itself, condensed and solved for at each α) on `problem`, and checks every event
+/// against the reference's affine events `f0 + φ f1` at φ = A sin(ω α): each met four
+/// times, up and down in each period (the classes swapped on the way down), to `tol` in
+/// φ. The affine load is checked against the reference first, to `tol` in α. Returns the
+/// number of events and the worst difference in φ.
+fn sine_general_against_reference(
+    case: &fricont_exchange::io::CaseData,
+    problem: Arc<fricont::Problem>,
+    (amp, omega): (f64, f64),
+    tol: f64,
+) -> (usize, f64) {
     let c = compare_with_fricont(
-        &condensed(&case),
-        double.clone(),
+        &condensed(case),
+        problem.clone(),
         &case.f0,
         &case.f1,
         -amp,
         amp,
-        1e-9,
+        tol,
         &mut no_progress(),
     );
-    // (in double alone: W's rounding moves its events by up to 1.0e-10)
-    c.check(1e-9)
-        .expect("the affine load against the reference");
+    c.check(tol).expect("the affine load against the reference");
     // φ runs 0 → A → −A → A → −A → 0.
     let aff = ref_events(&c.reference);
     let up = |keep: &dyn Fn(f64) -> bool| -> Vec<Ev> {
@@ -448,7 +428,7 @@ fn general_load_in_double_on_a_moderately_slender_body() {
     let load = fricont::Load::general(case.f0.len(), Box::new(f), None);
     let (a0, a1) = (0.0, 4.0 * std::f64::consts::PI / omega);
     let opts = fricont::PathOptions::window(a0, a1);
-    let mut path = fricont::Path::new(double, load, opts).expect("path");
+    let mut path = fricont::Path::new(problem, load, opts).expect("path");
     path.start(a0, None).expect("start");
     path.run()
         .unwrap_or_else(|e| panic!("after {} events: {e}", path.events().len()));
@@ -458,8 +438,66 @@ fn general_load_in_double_on_a_moderately_slender_body() {
         .iter()
         .map(|e| (amp * (omega * e.alpha).sin(), e.node, e.from, e.to))
         .collect();
-    let worst = compare_events(&got, &want, 1e-9).unwrap_or_else(|e| panic!("{e}"));
-    eprintln!("{} events, worst {worst:e} in φ", got.len());
+    let worst = compare_events(&got, &want, tol).unwrap_or_else(|e| panic!("{e}"));
+    (got.len(), worst)
+}
+
+/// A general load in double alone on a moderately slender body (67 × 6 nodes on
+/// 2.82 × 0.115, κ(W) ≈ 9.7e5, which `auto` leaves in double): `f0 + 1.5 sin(500 α) f1`,
+/// its 664 events to 1e-9 in φ (in double W's rounding alone moves the affine events by
+/// up to 1.0e-10). Solved afresh at each α, the guards carried rounding of cond · ε of
+/// the whole load, different at each α: the march stopped loudly after 325 events (the
+/// solutions at two α 2.3e-14 apart disagreed by 6.2e-13 on a guard whose threshold is
+/// 3.5e-13). Measured now: 3.2e-10 in φ.
+#[test]
+fn general_load_in_double_on_a_moderately_slender_body() {
+    let spec: RectSpec = serde_json::from_str(
+        r#"{"nx": 67, "ny": 6, "lx": 2.816478827916063, "ly": 0.11467220907561955,
+            "friction": 0.3,
+            "load0": [{"side": "top", "start": [0.006529728547488569, -0.005979787701059291],
+                       "end": [0.0007964457772528903, -0.011959575402118582]}],
+            "load1": [{"side": "top", "start": [-0.0020925322610123673, 0.006161412388091854],
+                       "end": [-0.00954923316172539, 0.0022156503811689727]},
+                      {"side": "right", "start": [-0.007249115492602159, 0.008818176316708665],
+                       "end": [0.004303542283064217, 0.0015691136377103398]}]}"#,
+    )
+    .expect("spec");
+    let case = generate(&spec).expect("generate");
+    let double = case
+        .builder()
+        .extended_precision(fricont::ExtendedPrecision::Off)
+        .build()
+        .expect("problem");
+    let (n, worst) = sine_general_against_reference(&case, Arc::new(double), (1.5, 500.0), 1e-9);
+    assert_eq!(n, 664);
+    eprintln!("{n} events, worst {worst:e} in φ");
+}
+
+/// A nonlinear load's transition where the closing guard was already at or below zero
+/// (within its threshold) at the end of the step before the one that took it as a
+/// crossing: its root is on that earlier step. A 77 × 3 rectangle on 6.72 × 0.14 with
+/// F = 5 under `f0 + 1.5 sin(50 α) f1` (extended precision, `auto`), 964 events to 1e-9
+/// in φ. The root used to be taken at the start of the crossing step: node 72 closed
+/// 1.4e-7 late in α, 1.0e-5 in φ (its gap's terms are 1.3e3, its slope 1.4 per unit α,
+/// and a general load's threshold includes the load's change over the window). Measured
+/// now: 1.0e-10 in φ against the same load as a basis load in extended precision.
+#[test]
+fn general_load_root_on_the_step_before() {
+    let spec: RectSpec = serde_json::from_str(
+        r#"{"nx": 77, "ny": 3, "lx": 6.718647902568992, "ly": 0.1398930957900279,
+            "friction": 5.0,
+            "load0": [{"side": "top", "start": [-0.0010269331958931774, -0.002724376154393407],
+                       "end": [-0.0002631780759050663, -0.0029433687114928347]}],
+            "load1": [{"side": "top", "start": [0.009491226692099305, 0.006973665605409065],
+                       "end": [0.007481007571017351, -0.008826849894352184]}]}"#,
+    )
+    .expect("spec");
+    let case = generate(&spec).expect("generate");
+    let problem = case.problem(None).expect("problem");
+    assert!(problem.extended_precision());
+    let (n, worst) = sine_general_against_reference(&case, Arc::new(problem), (1.5, 50.0), 1e-9);
+    assert_eq!(n, 964);
+    eprintln!("{n} events, worst {worst:e} in φ");
 }
 
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.

@@ -630,6 +630,8 @@ impl Path {
             Ok((pt, table))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
+        // The start of the step before `pa` and its guards (None on the first step).
+        let mut behind: Option<(f64, Vec<GuardRow>)> = None;
         let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
         // The first piece's march starts short and doubles its way up: a step trusted by
         // its midpoint can alias the load's period only when it spans whole periods, and
@@ -818,6 +820,7 @@ impl Path {
                 for (k, b) in below.iter_mut().enumerate() {
                     *b = *b && gb[k].value < -tol[k];
                 }
+                behind = Some((pa.alpha, ga));
                 pa = pb;
                 ga = gb;
                 h = (2.0 * h).min(hmax);
@@ -855,7 +858,27 @@ impl Path {
                 let (a0, b0) = (pa.alpha, pb.alpha);
                 let fa = ga[k].value;
                 let fb = gb[k].value;
-                let root = if fa <= 0.0 {
+                // A guard already at or below zero at α_a (within its threshold there, so
+                // not taken as a crossing then) reached zero on the step before: its root
+                // is found there, not taken at α_a. That was up to threshold / slope late
+                // (1.4e-7 in α for a gap of terms 1.3e3 closing at a slope of 1.4 per unit
+                // α, as general loads' thresholds include the load's change over the
+                // window).
+                let earlier = behind
+                    .as_ref()
+                    .map(|(a, rows)| (*a, rows[k].guard, rows[k].value, rows[k].slope))
+                    .filter(|&(_, guard, value, _)| guard == g && value > 0.0 && fa <= 0.0);
+                let root = if let Some((a_prev, _, value, slope)) = earlier {
+                    newton_bracketed(
+                        (a_prev, value, slope),
+                        (a0, fa, ga[k].slope),
+                        fine * tol[k],
+                        |x| {
+                            let rows = eval(self, x, false)?.1;
+                            Ok((rows[k].value, rows[k].slope))
+                        },
+                    )?
+                } else if fa <= 0.0 {
                     a0
                 } else {
                     newton_bracketed(
@@ -877,8 +900,10 @@ impl Path {
             // Up to the root, no guard may dip below zero: neither at the root itself nor
             // in its cubic Hermite model on [α_a, root] (the models were trusted on the
             // whole step). Else the step is shortened to the first half of that stretch.
+            // (A root on the step before lies on a stretch already trusted.)
             let stretch = root - pa.alpha;
-            let dip = dips(&ga, &tab, stretch, &tol, |k| below[k] || tab[k].guard == g);
+            let before = dir * stretch < 0.0;
+            let dip = !before && dips(&ga, &tab, stretch, &tol, |k| below[k] || tab[k].guard == g);
             if dip && h > hmin && stretch != 0.0 {
                 h = 0.5 * stretch.abs();
                 continue;
@@ -921,7 +946,11 @@ impl Path {
                     let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
                     Ok((Point { lam, ..at }, table))
                 };
-                let (lo_a, hi_a) = (pa.alpha.min(pb.alpha), pa.alpha.max(pb.alpha));
+                let from = match &behind {
+                    Some((a_prev, _)) if before => *a_prev,
+                    _ => pa.alpha,
+                };
+                let (lo_a, hi_a) = (from.min(pb.alpha), from.max(pb.alpha));
                 let (mut x0, mut v0) = (root, tab[k].value);
                 let slope = tab[k].slope;
                 let accept = 0.25 * self.tol_at(&pt).of(&self.consts().guard_form(g));
