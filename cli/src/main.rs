@@ -132,7 +132,7 @@ struct TraceArgs {
     /// Carry W and the condensed loads beyond double precision (mixed-precision
     /// refinement with the factor of A, for slender bodies whose W is ill-conditioned):
     /// auto where the refinement is cheap (at most 2e8 flops: small problems, whatever W's
-    /// condition), or where the condition estimate of W exceeds 1e7 and the cost is
+    /// condition), or where the condition estimate of W exceeds 1e6 and the cost is
     /// moderate.
     #[arg(long, value_enum, default_value_t = Extended::Auto)]
     extended_precision: Extended,

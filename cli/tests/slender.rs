@@ -500,6 +500,45 @@ fn general_load_root_on_the_step_before() {
     eprintln!("{n} events, worst {worst:e} in φ");
 }
 
+/// `auto` refines W from κ(W) ≈ 1e6 on (`AUTO_CONDITION`): a 74 × 4 rectangle on
+/// 7.1 × 0.29 with F = 3.5 (κ ≈ 1.6e6, its refinement above `AUTO_SMALL_FLOPS`) traced
+/// under `auto` agrees with the reference to 1e-10. `auto` used to leave it in double
+/// (the threshold was 1e7), where the corner node's stick → slip− was 8.6e-9 off in α.
+#[test]
+fn auto_refines_a_moderately_ill_conditioned_rectangle() {
+    let spec: RectSpec = serde_json::from_str(
+        r#"{"nx": 74, "ny": 4, "lx": 7.141374320807975, "ly": 0.28996187918072713,
+            "friction": 3.5,
+            "load0": [{"side": "top", "start": [-0.007046878928294218, -0.009131188164689006],
+                       "end": [-0.008319145136182569, -0.018321677903012562]}],
+            "load1": [{"side": "top", "start": [-0.005195542213988034, -0.0042648870399749185],
+                       "end": [-0.0028046139243221727, 0.003098184520914666]},
+                      {"side": "right", "start": [-0.006861720976289303, -0.00789369029403727],
+                       "end": [-0.004082813884477121, -0.006082313418048439]}]}"#,
+    )
+    .expect("spec");
+    let case = generate(&spec).expect("generate");
+    let problem = case.problem(None).expect("problem");
+    let kappa = problem.w_condition_estimate();
+    assert!(kappa > 1e6 && kappa < 1e7, "κ estimate {kappa:e}");
+    assert!(
+        problem.extended_precision(),
+        "auto left κ = {kappa:e} in double"
+    );
+    let c = compare_with_fricont(
+        &condensed(&case),
+        Arc::new(problem),
+        &case.f0,
+        &case.f1,
+        -1.5,
+        1.5,
+        1e-10,
+        &mut no_progress(),
+    );
+    c.check(1e-10).expect("against the reference");
+    assert!(c.fricont.len() >= 3, "{} events", c.fricont.len());
+}
+
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.
 fn strip(p: usize) -> RectSpec {
     RectSpec {
