@@ -378,6 +378,13 @@ fn random_rectangles() {
     assert!(folds > 0, "no fold among the rectangles");
 }
 
+/// The generated rectangle of a [`RectSpec`] given as JSON (the exchange format's keys;
+/// the others as in `RectSpec::default()`).
+fn rect_case(json: &str) -> fricont_exchange::io::CaseData {
+    let spec: RectSpec = serde_json::from_str(json).expect("spec");
+    generate(&spec).expect("generate")
+}
+
 /// Traces `f0 + A sin(ω α) f1` over two periods from α = 0 as a general load (`f(α)`
 /// itself, condensed and solved for at each α) on `problem`, and checks every event
 /// against the reference's affine events `f0 + φ f1` at φ = A sin(ω α): each met four
@@ -451,7 +458,7 @@ fn sine_general_against_reference(
 /// 3.5e-13). Measured now: 3.2e-10 in φ.
 #[test]
 fn general_load_in_double_on_a_moderately_slender_body() {
-    let spec: RectSpec = serde_json::from_str(
+    let case = rect_case(
         r#"{"nx": 67, "ny": 6, "lx": 2.816478827916063, "ly": 0.11467220907561955,
             "friction": 0.3,
             "load0": [{"side": "top", "start": [0.006529728547488569, -0.005979787701059291],
@@ -460,9 +467,7 @@ fn general_load_in_double_on_a_moderately_slender_body() {
                        "end": [-0.00954923316172539, 0.0022156503811689727]},
                       {"side": "right", "start": [-0.007249115492602159, 0.008818176316708665],
                        "end": [0.004303542283064217, 0.0015691136377103398]}]}"#,
-    )
-    .expect("spec");
-    let case = generate(&spec).expect("generate");
+    );
     let double = case
         .builder()
         .extended_precision(fricont::ExtendedPrecision::Off)
@@ -483,16 +488,14 @@ fn general_load_in_double_on_a_moderately_slender_body() {
 /// now: 1.0e-10 in φ against the same load as a basis load in extended precision.
 #[test]
 fn general_load_root_on_the_step_before() {
-    let spec: RectSpec = serde_json::from_str(
+    let case = rect_case(
         r#"{"nx": 77, "ny": 3, "lx": 6.718647902568992, "ly": 0.1398930957900279,
             "friction": 5.0,
             "load0": [{"side": "top", "start": [-0.0010269331958931774, -0.002724376154393407],
                        "end": [-0.0002631780759050663, -0.0029433687114928347]}],
             "load1": [{"side": "top", "start": [0.009491226692099305, 0.006973665605409065],
                        "end": [0.007481007571017351, -0.008826849894352184]}]}"#,
-    )
-    .expect("spec");
-    let case = generate(&spec).expect("generate");
+    );
     let problem = case.problem(None).expect("problem");
     assert!(problem.extended_precision());
     let (n, worst) = sine_general_against_reference(&case, Arc::new(problem), (1.5, 50.0), 1e-9);
@@ -506,7 +509,7 @@ fn general_load_root_on_the_step_before() {
 /// (the threshold was 1e7), where the corner node's stick → slip− was 8.6e-9 off in α.
 #[test]
 fn auto_refines_a_moderately_ill_conditioned_rectangle() {
-    let spec: RectSpec = serde_json::from_str(
+    let case = rect_case(
         r#"{"nx": 74, "ny": 4, "lx": 7.141374320807975, "ly": 0.28996187918072713,
             "friction": 3.5,
             "load0": [{"side": "top", "start": [-0.007046878928294218, -0.009131188164689006],
@@ -515,9 +518,7 @@ fn auto_refines_a_moderately_ill_conditioned_rectangle() {
                        "end": [-0.0028046139243221727, 0.003098184520914666]},
                       {"side": "right", "start": [-0.006861720976289303, -0.00789369029403727],
                        "end": [-0.004082813884477121, -0.006082313418048439]}]}"#,
-    )
-    .expect("spec");
-    let case = generate(&spec).expect("generate");
+    );
     let problem = case.problem(None).expect("problem");
     let kappa = problem.w_condition_estimate();
     assert!(kappa > 1e6 && kappa < 1e7, "κ estimate {kappa:e}");
