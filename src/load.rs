@@ -178,7 +178,7 @@ pub(crate) struct BoundLoad {
     /// root, then the join at it), and each evaluation costs the user's callbacks and a
     /// solve with A.
     last_general: Option<GeneralEval>,
-    /// A general load's anchor `(f(α_a), q(α_a))` ([`Self::set_anchor`]).
+    /// A general load's anchor `(f(α_a), q(α_a))` ([`Self::anchor_at`]).
     anchor: Option<(Vec<f64>, Vec<f64>)>,
 }
 
@@ -305,24 +305,30 @@ impl BoundLoad {
         Some((&e.q, e.q_lo.as_deref()?))
     }
 
-    /// Anchors a general load at `alpha` (`None` drops the anchor; a no-op for other
-    /// loads): until it is dropped, [`Self::q`] condenses the change `f(α) − f(α_a)` and
-    /// adds it to `q(α_a)`. The rounding of q(α) is then proportional to that change:
-    /// smooth in α near α_a, where a fresh condensation at each α differs from the next
-    /// by `κ(A) ε ‖q‖`, noise that can exceed a slender body's guard thresholds. Errors:
+    /// Anchors a general load at `alpha` (a no-op for other loads): until
+    /// [`Self::drop_anchor`], [`Self::q`] condenses the change `f(α) − f(α_a)` and adds it
+    /// to `q(α_a)`. The rounding of q(α) is then proportional to that change: smooth in α
+    /// near α_a, where a fresh condensation at each α differs from the next by
+    /// `κ(A) ε ‖q‖`, noise that can exceed a slender body's guard thresholds. Errors:
     /// those of [`Self::q`] at `alpha`.
-    pub(crate) fn set_anchor(&mut self, alpha: Option<f64>, del: &Delassus) -> Result<()> {
-        self.anchor = None;
-        self.last_general = None;
-        let (Some(alpha), Load::General { .. }) = (alpha, &self.load) else {
+    pub(crate) fn anchor_at(&mut self, alpha: f64, del: &Delassus) -> Result<()> {
+        self.drop_anchor();
+        if !matches!(self.load, Load::General { .. }) {
             return Ok(());
-        };
+        }
         self.q(alpha, del)?;
         self.anchor = self
             .last_general
             .as_ref()
             .map(|e| (e.f.clone(), e.q.clone()));
         Ok(())
+    }
+
+    /// Drops the anchor of [`Self::anchor_at`] (and the last evaluation, made relative to
+    /// it).
+    pub(crate) fn drop_anchor(&mut self) {
+        self.anchor = None;
+        self.last_general = None;
     }
 
     /// For a basis load: its condensed vectors `q_j`, so that `q(α) = Σ_j w_j(α) q_j`.

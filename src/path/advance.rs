@@ -493,7 +493,7 @@ impl Path {
     /// guards' Hermite interpolants certify free of double crossings, then Brent.
     ///
     /// A general load in double precision is evaluated relative to the piece's entry
-    /// point: `q(α) = q(α_e) + (condensed f(α) − f(α_e))` ([`BoundLoad::set_anchor`]) and
+    /// point: `q(α) = q(α_e) + (condensed f(α) − f(α_e))` ([`BoundLoad::anchor_at`]) and
     /// `λ(α) = λ(α_e) + M_S⁻¹ (b(q(α)) − b(q(α_e)))`, d likewise. Solved afresh at each α,
     /// λ and d carry rounding of `cond · ε` of the whole load, different at each α: on a
     /// slender body that noise exceeded the guards' thresholds, so that the march stopped
@@ -509,10 +509,10 @@ impl Path {
             return self.exit_graph_on(cur, None);
         }
         let problem = self.problem.clone();
-        self.load.set_anchor(Some(cur.alpha), problem.delassus())?;
+        self.load.anchor_at(cur.alpha, problem.delassus())?;
         let entry = std::cell::RefCell::new(None);
         let out = self.exit_graph_on(cur, Some(&entry));
-        self.load.set_anchor(None, problem.delassus())?;
+        self.load.drop_anchor();
         out
     }
 
@@ -535,6 +535,8 @@ impl Path {
                 ))
             }
         };
+        let add =
+            |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| x + y).collect() };
         // λ, d, dλ/dα and the rate of d along (dλ/dα, 1) from solves with M_S: both
         // columns in one pass over the factor and one product with W.
         let solve = |this: &Self, qg: &[f64], dq: &[f64]| -> [Vec<f64>; 4] {
@@ -555,9 +557,6 @@ impl Path {
                         .unzip()
                 }
                 (None, PieceSolver::Full(_)) => unreachable!("a full solver has its dense LU"),
-            };
-            let add = |a: &[f64], b: &[f64]| -> Vec<f64> {
-                a.iter().zip(b).map(|(x, y)| x + y).collect()
             };
             let [lam, dl]: [Vec<f64>; 2] = xs.try_into().expect("two columns");
             [lam, add(qg, &wxs[0]), dl, add(dq, &wxs[1])]
@@ -590,9 +589,6 @@ impl Path {
                             let change: Vec<f64> =
                                 at.q.iter().zip(&e.q).map(|(a, b)| a - b).collect();
                             let [dl, dd, t, rate] = solve(this, &change, dq);
-                            let add = |a: &[f64], b: &[f64]| -> Vec<f64> {
-                                a.iter().zip(b).map(|(x, y)| x + y).collect()
-                            };
                             [add(&e.lam, &dl), add(&e.d, &dd), t, rate]
                         }
                         None => {
