@@ -509,16 +509,7 @@ fn general_load_root_on_the_step_before() {
 /// (the threshold was 1e7), where the corner node's stick → slip− was 8.6e-9 off in α.
 #[test]
 fn auto_refines_a_moderately_ill_conditioned_rectangle() {
-    let case = rect_case(
-        r#"{"nx": 74, "ny": 4, "lx": 7.141374320807975, "ly": 0.28996187918072713,
-            "friction": 3.5,
-            "load0": [{"side": "top", "start": [-0.007046878928294218, -0.009131188164689006],
-                       "end": [-0.008319145136182569, -0.018321677903012562]}],
-            "load1": [{"side": "top", "start": [-0.005195542213988034, -0.0042648870399749185],
-                       "end": [-0.0028046139243221727, 0.003098184520914666]},
-                      {"side": "right", "start": [-0.006861720976289303, -0.00789369029403727],
-                       "end": [-0.004082813884477121, -0.006082313418048439]}]}"#,
-    );
+    let case = moderately_ill_conditioned_rectangle();
     let problem = case.problem(None).expect("problem");
     let kappa = problem.w_condition_estimate();
     assert!(kappa > 1e6 && kappa < 1e7, "κ estimate {kappa:e}");
@@ -538,6 +529,38 @@ fn auto_refines_a_moderately_ill_conditioned_rectangle() {
     );
     c.check(1e-10).expect("against the reference");
     assert!(c.fricont.len() >= 3, "{} events", c.fricont.len());
+}
+
+/// A 74 × 4 rectangle on 7.14 × 0.29, F = 3.5, κ(W) ≈ 1.6e6.
+fn moderately_ill_conditioned_rectangle() -> fricont_exchange::io::CaseData {
+    rect_case(
+        r#"{"nx": 74, "ny": 4, "lx": 7.141374320807975, "ly": 0.28996187918072713,
+            "friction": 3.5,
+            "load0": [{"side": "top", "start": [-0.007046878928294218, -0.009131188164689006],
+                       "end": [-0.008319145136182569, -0.018321677903012562]}],
+            "load1": [{"side": "top", "start": [-0.005195542213988034, -0.0042648870399749185],
+                       "end": [-0.0028046139243221727, 0.003098184520914666]},
+                      {"side": "right", "start": [-0.006861720976289303, -0.00789369029403727],
+                       "end": [-0.004082813884477121, -0.006082313418048439]}]}"#,
+    )
+}
+
+/// The same rectangle under `f0 + 1.5 sin(500 α) f1` as a general load (extended
+/// precision, chosen by `auto`): its corner node 73 closes in slip+ and sticks again
+/// 3.3e-5 in α later, on a slip piece so nearly singular that its points solved in
+/// double were 4e-5 of max|λ| off (λt of node 73: −6.8e-8 where it is 0 at the entry).
+/// Their refinement in double-double moved them farther than the polish took, so the
+/// march went on with the double points, and at the next transition node 73 fit no
+/// class ("the point is not a solution"). All its events against the reference's affine
+/// events mapped through the sine, to 1e-9 in φ.
+#[test]
+fn general_load_through_a_nearly_singular_slip_piece() {
+    let case = moderately_ill_conditioned_rectangle();
+    let problem = Arc::new(case.problem(None).expect("problem"));
+    assert!(problem.extended_precision());
+    let (events, worst) = sine_general_against_reference(&case, problem, (1.5, 500.0), 1e-9);
+    eprintln!("{events} events, worst {worst:e} in φ");
+    assert!(events >= 12, "{events} events");
 }
 
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.

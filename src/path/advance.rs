@@ -190,7 +190,7 @@ impl Path {
         let PieceSolver::Updated(u) = &*cur.lu else {
             return None;
         };
-        let (rel, d, r) = self.point_residual(cur, qg, &lam);
+        let (rel, d, r) = self.point_residual(&cur.classes, qg, &lam);
         if rel <= update::REFINE_ABOVE || (refined && rel <= 1e-12) {
             return Some((lam, d));
         }
@@ -210,20 +210,20 @@ impl Path {
         })
     }
 
-    /// The relative residual of `lam` on the current piece's equations from the data
-    /// (`qg = q(α) − (g, 0)`; one product with W), with its d and the residual rows.
-    fn point_residual(
+    /// The relative residual of `lam` on the equations of the piece `classes` from the
+    /// data (`qg = q(α) − (g, 0)`; one product with W), with its d and the residual rows.
+    pub(super) fn point_residual(
         &self,
-        cur: &CurrentPiece,
+        classes: &[Class],
         qg: &[f64],
         lam: &[f64],
     ) -> (f64, Vec<f64>, Vec<f64>) {
         let c = self.consts();
         let d = displacement_gaps(self.problem.delassus().w(), qg, lam);
         let zeros = vec![0.0; 2 * c.p];
-        let r = update::residual_rows(&c, &cur.classes, lam, &d, &zeros);
-        let rhs = c.piece_rhs(&cur.classes, qg);
-        let rel = update::relative_residual(&c, &cur.classes, &r, lam, &rhs, self.row_bound());
+        let r = update::residual_rows(&c, classes, lam, &d, &zeros);
+        let rhs = c.piece_rhs(classes, qg);
+        let rel = update::relative_residual(&c, classes, &r, lam, &rhs, self.row_bound());
         (rel, d, r)
     }
 
@@ -993,7 +993,7 @@ impl Path {
                 // (one product with W) within a solve's check, else solved for there.
                 if let Some(p) = best {
                     let qg = shift_gap(&p.q, self.problem.gap_equilibrated());
-                    let (rel, d_data, _) = self.point_residual(cur, &qg, &p.lam);
+                    let (rel, d_data, _) = self.point_residual(&cur.classes, &qg, &p.lam);
                     pt = if rel <= 1e-12 {
                         self.prime_gaps(p.alpha, &p.lam, d_data);
                         p

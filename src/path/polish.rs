@@ -255,11 +255,13 @@ pub(super) struct RefinedPiece {
     pub(super) rounded: [Vec<f64>; 4],
 }
 
-/// A double-double point `lam2` is taken for the double-precision one `lam` only where
-/// the two lie within [`NEAR`] of each other (relative to max|λ|): what double precision
-/// gets wrong on a slender body is ~1e-7 at most (in α, and so in λ along the piece); a
-/// larger move means a piece whose point is ill-determined, and the double point, found
-/// with the tracer's own checks, is kept.
+/// A double-double point `lam2` is taken for the double-precision one `lam` without
+/// further checks only where the two lie within [`NEAR`] of each other (relative to
+/// max|λ|): what double precision gets wrong on a slender body is ~1e-7 at most (in α,
+/// and so in λ along the piece). A larger move means a piece whose point is
+/// ill-determined: the double point, found with the tracer's own checks, is kept, except
+/// by [`Path::polish_point`] where the refined point solves the piece from the data at
+/// least as well.
 pub(super) fn near(lam2: &[f64], lam: &[f64]) -> bool {
     let dl: Vec<f64> = lam2.iter().zip(lam).map(|(x, y)| x - y).collect();
     // (a NaN anywhere makes the norms NaN: not near)
@@ -377,7 +379,8 @@ impl Path {
     /// from the guess `lam` and rounded, with its `d = W λ + q(α) − (g, 0)` (from the
     /// double-double one): the start point, and each point of a general load's march.
     /// None as for [`Self::refiner`], when the refinement does not converge, or when it
-    /// lands farther from `lam` than [`near`] allows.
+    /// lands farther from `lam` than [`near`] allows and does not solve the piece's
+    /// equations from the data to 1e-12 (relative residual, one product with W).
     pub(super) fn polish_point(
         &mut self,
         classes: &[Class],
@@ -401,8 +404,27 @@ impl Path {
         let (x, d) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
         let out: Vec<f64> = (0..x.hi.len()).map(|k| x.get(k).to_f64()).collect();
         let d: Vec<f64> = (0..d.hi.len()).map(|k| d.get(k).to_f64()).collect();
-        let finite = out.iter().chain(&d).all(|v| v.is_finite());
-        (finite && near(&out, lam)).then_some((out, d))
+        if !out.iter().chain(&d).all(|v| v.is_finite()) {
+            return None;
+        }
+        if near(&out, lam) {
+            return Some((out, d));
+        }
+        // Farther from the double-precision point than `near` allows: taken where it
+        // solves the piece from the data at least as well as that point (their relative
+        // residuals in double, one product with W each). The double point of a nearly
+        // singular piece can be that far off (4e-5 of max|λ| on a slip piece of a
+        // slender body entered 3e-5 in α before its next transition: its node then fit
+        // no class at that transition, where the refined points trace through); a
+        // refinement that "converged" to a non-solution (a garbage first step) leaves a
+        // residual of order one.
+        let qg = shift_gap(
+            &self.load.q(alpha, problem.delassus()).ok()?.0,
+            problem.gap_equilibrated(),
+        );
+        let (rel, _, _) = self.point_residual(classes, &qg, &out);
+        let (rel_double, _, _) = self.point_residual(classes, &qg, lam);
+        (rel <= rel_double.max(1e-12)).then_some((out, d))
     }
 
     /// The straight piece `cur` (affine load, α moving) refined in double-double: its
