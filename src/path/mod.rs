@@ -747,7 +747,7 @@ impl Path {
     /// The "at zero" thresholds at a point. A row `d_k` of the displacement gaps is at
     /// zero below `zero_tol · r0 (|q_k|ₜ + |g_k| + (|W| |λ|)_k)` (but not below 1e-3 of the
     /// point's threshold: the rows of q come from solves with A), with `|q_k|ₜ` the
-    /// magnitude of the terms of `q_k(α)` (see [`BoundLoad::term_magnitude`]): what its
+    /// magnitude of the terms of `q_k(α)` (see [`BoundLoad::term_magnitude_rows`]): what its
     /// rounding is proportional to, row by row (on slender bodies the rows of q differ by
     /// orders of magnitude). A force form is at zero below `zero_tol` times the contact
     /// forces, `max(‖λ‖∞, force scale / 10)` (the floor keeps the rounding of λ, which is
