@@ -397,6 +397,18 @@ fn sine_general_against_reference(
     (amp, omega): (f64, f64),
     tol: f64,
 ) -> (usize, f64) {
+    sine_against_reference(case, problem, (amp, omega), false, tol)
+}
+
+/// [`sine_general_against_reference`], with the load given as a basis load (vectors f0,
+/// f1, weights 1 and A sin(ω α)) where `basis`.
+fn sine_against_reference(
+    case: &fricont_exchange::io::CaseData,
+    problem: Arc<fricont::Problem>,
+    (amp, omega): (f64, f64),
+    basis: bool,
+    tol: f64,
+) -> (usize, f64) {
     let c = compare_with_fricont(
         &condensed(case),
         problem.clone(),
@@ -425,14 +437,25 @@ fn sine_general_against_reference(
     want.extend(down());
     want.extend(up(&|phi| phi < 0.0));
     let (f0, f1) = (case.f0.clone(), case.f1.clone());
-    let f = move |a: f64, out: &mut [f64]| {
-        let s = amp * (omega * a).sin();
-        for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
-            *o = x + s * y;
-        }
-        Ok::<(), fricont::load::LoadFailure>(())
+    let load = if basis {
+        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+            w[0] = 1.0;
+            w[1] = amp * (omega * a).sin();
+            dw[0] = 0.0;
+            dw[1] = amp * omega * (omega * a).cos();
+            Ok::<(), fricont::load::LoadFailure>(())
+        };
+        fricont::Load::basis(vec![f0, f1], Box::new(weights)).expect("basis load")
+    } else {
+        let f = move |a: f64, out: &mut [f64]| {
+            let s = amp * (omega * a).sin();
+            for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+                *o = x + s * y;
+            }
+            Ok::<(), fricont::load::LoadFailure>(())
+        };
+        fricont::Load::general(case.f0.len(), Box::new(f), None)
     };
-    let load = fricont::Load::general(case.f0.len(), Box::new(f), None);
     let (a0, a1) = (0.0, 4.0 * std::f64::consts::PI / omega);
     let opts = fricont::PathOptions::window(a0, a1);
     let mut path = fricont::Path::new(problem, load, opts).expect("path");
@@ -561,6 +584,47 @@ fn general_load_through_a_nearly_singular_slip_piece() {
     let (events, worst) = sine_general_against_reference(&case, problem, (1.5, 500.0), 1e-9);
     eprintln!("{events} events, worst {worst:e} in φ");
     assert!(events >= 12, "{events} events");
+}
+
+/// A node that opened re-closes at a shallow angle under a basis load (extended
+/// precision): 80 × 2 and 64 × 2 rectangles with F = 5 under `f0 + 1.5 sin(ω α) f1`,
+/// whose corner node re-closes where its gap's slope is about 5e-8 of its terms. The
+/// root found on points rounded to double (each d carries the rounding of its terms)
+/// was 4e-9 off in φ; corrected on the point refined in double-double it is within
+/// 1e-12 of the reference's (measured 2e-15).
+#[test]
+fn basis_load_re_closing_at_a_shallow_angle() {
+    for (json, omega) in [
+        (
+            r#"{"nx": 80, "ny": 2, "lx": 6.018692659352522, "ly": 0.11337041876647559,
+                "friction": 5.0,
+                "load0": [{"side": "top", "start": [0.005924637049651087, -0.010836639928308545],
+                           "end": [-0.007927943187449046, -0.021697405834105787]}],
+                "load1": [{"side": "top", "start": [0.008840408380898243, 0.000521677410954078],
+                           "end": [0.002626609058785383, 0.005277919330528347]},
+                          {"side": "right", "start": [0.00422396819024125, -0.005174094779395458],
+                           "end": [-0.007336270515793681, -0.0027993209520924415]}]}"#,
+            50.0,
+        ),
+        (
+            r#"{"nx": 64, "ny": 2, "lx": 7.952923607821075, "ly": 0.1443365898088999,
+                "friction": 5.0,
+                "load0": [{"side": "top", "start": [-0.009378156648765106, -0.010246767355325148],
+                           "end": [-0.008015005466471442, -0.016086567817588833]}],
+                "load1": [{"side": "top", "start": [0.008786898430590514, 0.0011225186926339115],
+                           "end": [0.0022555161101744485, -0.0009653672134708885]},
+                          {"side": "right", "start": [0.0026406766480981045, -0.000290986293219166],
+                           "end": [-0.0011849336508953593, -0.0002173792106548375]}]}"#,
+            50.0,
+        ),
+    ] {
+        let case = rect_case(json);
+        let problem = Arc::new(case.problem(None).expect("problem"));
+        assert!(problem.extended_precision());
+        let (events, worst) = sine_against_reference(&case, problem, (1.5, omega), true, 1e-12);
+        eprintln!("{events} events, worst {worst:e} in φ");
+        assert!(events >= 8, "{events} events");
+    }
 }
 
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.

@@ -227,6 +227,55 @@ impl Path {
         (rel, d, r)
     }
 
+    /// In extended precision, the root of guard `k` (slope `slope` per unit α, zero
+    /// threshold `tol_k`) of the piece `cur` under a basis load corrected on the point
+    /// refined in double-double. A point rounded to double carries the rounding of its
+    /// terms in each d (ε |W||λ|): where the guard crosses at a shallow angle against
+    /// them, that moves the root by about ε |terms| / slope (4e-9 in φ where a node
+    /// re-closed at a slope of 5e-8 of its terms), while the refined d is accurate to the
+    /// data. So where that estimate exceeds 1e-12 of the window, `pt` is refined, and the
+    /// root moved by one Newton step on the refined guard, the point with it along the
+    /// piece's tangent (`bs` at α: a step of that rounding's size, whose own error is its
+    /// square). None when the problem is carried in double, the root is well determined
+    /// in double, or the refinement fails or lands beyond that rounding.
+    fn polish_root(
+        &mut self,
+        cur: &CurrentPiece,
+        bs: &BasisSolutions,
+        (k, slope, tol_k): (usize, f64, f64),
+        pt: &Point,
+    ) -> Result<Option<Point>> {
+        let roundings = 64.0 * tol_k * f64::EPSILON / self.opts.zero_tol;
+        let bound = 1e-12 * self.alpha_scale() * slope.abs();
+        if !self.problem.extended_precision()
+            || roundings.partial_cmp(&bound) != Some(std::cmp::Ordering::Greater)
+        {
+            return Ok(None);
+        }
+        let Some((lam, d)) = self.polish_point(&cur.classes, &cur.lu, pt.alpha, &pt.lam) else {
+            return Ok(None);
+        };
+        // A step within the window, of the size of the rounding it corrects (more means
+        // a refinement that did not land near this root: `pt` is kept).
+        let v = self.guard_rows(&cur.classes, &lam, &d, None)[k].value;
+        let (lo, hi) = self.window();
+        let step = (pt.alpha - v / slope).clamp(lo, hi) - pt.alpha;
+        let Some((w, dw)) = self
+            .load
+            .weights_at(pt.alpha)
+            .filter(|_| v.abs() <= roundings && step.is_finite())
+        else {
+            return Ok(None);
+        };
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+        let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
+        let lam: Vec<f64> = lam.iter().zip(&t).map(|(l, t)| l + step * t).collect();
+        let d: Vec<f64> = d.iter().zip(&rate).map(|(x, r)| x + step * r).collect();
+        let alpha = pt.alpha + step;
+        self.prime_gaps(alpha, &lam, d);
+        Ok(Some(self.point_at(lam, alpha)?))
+    }
+
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
     /// with the rate of d along it (`W t_λ + q' t_α`, see [`Path::rate_along`]).
     pub(super) fn guard_table(
@@ -1000,6 +1049,10 @@ impl Path {
                     } else {
                         eval(self, p.alpha, true)?.0
                     };
+                }
+                let tol_k = self.tol_at(&pt).of(&self.consts().guard_form(g));
+                if let Some(p) = self.polish_root(cur, bs, (k, slope, tol_k), &pt)? {
+                    pt = p;
                 }
             }
             return Ok(Exit::Guards(pt, vec![g]));
