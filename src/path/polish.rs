@@ -379,8 +379,9 @@ impl Path {
     /// from the guess `lam` and rounded, with its `d = W λ + q(α) − (g, 0)` (from the
     /// double-double one): the start point, and each point of a general load's march.
     /// None as for [`Self::refiner`], when the refinement does not converge, or when it
-    /// lands farther from `lam` than [`near`] allows and does not solve the piece's
-    /// equations from the data to 1e-12 (relative residual, one product with W).
+    /// lands farther from `lam` than [`near`] allows and solves the piece's equations
+    /// from the data less well than `lam` (relative residuals, one product with W each;
+    /// a residual up to 1e-12 always passes).
     pub(super) fn polish_point(
         &mut self,
         classes: &[Class],
