@@ -227,29 +227,33 @@ impl Path {
         (rel, d, r)
     }
 
-    /// In extended precision, the root of guard `k` (slope `slope` per unit α, zero
-    /// threshold `tol_k`) of the piece `cur` under a basis load corrected on the point
-    /// refined in double-double. A point rounded to double carries the rounding of its
+    /// In extended precision, the root of guard `g` (row `k` of the piece's guard
+    /// table, slope `slope` per unit α) of the piece `cur` under a basis load corrected
+    /// on the point refined in double-double. A point rounded to double carries the rounding of its
     /// terms in each d (ε |W||λ|): where the guard crosses at a shallow angle against
     /// them, that moves the root by about ε |terms| / slope (4e-9 in φ where a node
     /// re-closed at a slope of 5e-8 of its terms), while the refined d is accurate to the
     /// data. So where that estimate exceeds 1e-12 of the window, `pt` is refined, and the
     /// root moved by one Newton step on the refined guard, the point with it along the
     /// piece's tangent (`bs` at α: a step of that rounding's size, whose own error is its
-    /// square). None when the problem is carried in double, the root is well determined
-    /// in double, or the refinement fails or lands beyond that rounding.
+    /// square). `per_tol`: the roundings of a guard's terms that count, as a fraction of
+    /// its zero threshold (64 ε / `zero_tol`, as for the march's roots). None when the
+    /// problem is carried in double, the root is well determined in double, or the
+    /// refinement fails or lands beyond that rounding.
     fn polish_root(
         &mut self,
         cur: &CurrentPiece,
         bs: &BasisSolutions,
-        (k, slope, tol_k): (usize, f64, f64),
+        (k, g, slope): (usize, Guard, f64),
+        per_tol: f64,
         pt: &Point,
     ) -> Result<Option<Point>> {
-        let roundings = 64.0 * tol_k * f64::EPSILON / self.opts.zero_tol;
+        if !self.problem.extended_precision() {
+            return Ok(None);
+        }
+        let roundings = per_tol * self.tol_at(pt).of(&self.consts().guard_form(g));
         let bound = 1e-12 * self.alpha_scale() * slope.abs();
-        if !self.problem.extended_precision()
-            || roundings.partial_cmp(&bound) != Some(std::cmp::Ordering::Greater)
-        {
+        if roundings.partial_cmp(&bound) != Some(std::cmp::Ordering::Greater) {
             return Ok(None);
         }
         let Some((lam, d)) = self.polish_point(&cur.classes, &cur.lu, pt.alpha, &pt.lam) else {
@@ -260,11 +264,10 @@ impl Path {
         let v = self.guard_rows(&cur.classes, &lam, &d, None)[k].value;
         let (lo, hi) = self.window();
         let step = (pt.alpha - v / slope).clamp(lo, hi) - pt.alpha;
-        let Some((w, dw)) = self
-            .load
-            .weights_at(pt.alpha)
-            .filter(|_| v.abs() <= roundings && step.is_finite())
-        else {
+        if v.abs() > roundings || !step.is_finite() {
+            return Ok(None);
+        }
+        let Some((w, dw)) = self.load.weights_at(pt.alpha) else {
             return Ok(None);
         };
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
@@ -896,7 +899,8 @@ impl Path {
             // slopes), until the guard is within 64 roundings of its own scale (its
             // tolerance is `zero_tol` of that scale), then one more Newton step, not
             // evaluated (see [`newton_bracketed`]): the earliest root wins.
-            let fine = (64.0 * f64::EPSILON / self.opts.zero_tol).min(0.25);
+            let roundings = 64.0 * f64::EPSILON / self.opts.zero_tol;
+            let fine = roundings.min(0.25);
             let mut first: Option<(f64, Guard)> = None;
             for &k in &crossing {
                 let g = gb[k].guard;
@@ -1050,8 +1054,7 @@ impl Path {
                         eval(self, p.alpha, true)?.0
                     };
                 }
-                let tol_k = self.tol_at(&pt).of(&self.consts().guard_form(g));
-                if let Some(p) = self.polish_root(cur, bs, (k, slope, tol_k), &pt)? {
+                if let Some(p) = self.polish_root(cur, bs, (k, g, slope), roundings, &pt)? {
                     pt = p;
                 }
             }
