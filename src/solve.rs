@@ -109,7 +109,7 @@ fn merit(c: &PieceConstants, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Fr
 }
 
 /// The classes of the generalized Jacobian at `λ` (projection arguments).
-fn active_classes(
+pub(crate) fn active_classes(
     c: &PieceConstants,
     w: MatRef<'_, f64>,
     qg: &[f64],

@@ -387,16 +387,16 @@ fn rect_case(json: &str) -> fricont_exchange::io::CaseData {
 
 /// Traces `f0 + A sin(ω α) f1` over two periods from α = 0 as a general load (`f(α)`
 /// itself, condensed and solved for at each α) on `problem`, and checks every event
-/// against the reference's affine events `f0 + φ f1` at φ = A sin(ω α): each met four
-/// times, up and down in each period (the classes swapped on the way down), to `tol` in
-/// φ. The affine load is checked against the reference first, to `tol` in α. Returns the
-/// number of events and the worst difference in φ.
+/// against the reference's affine events `f0 + φ f1` at φ = A sin(ω α) ([`sine_walk`]:
+/// each met up and down in each period, the classes swapped on the way down), to `tol` in
+/// φ, and its folds. The affine load is checked against the reference first, to `tol` in
+/// α. Returns the number of events, of folds, and the worst difference in φ.
 fn sine_general_against_reference(
     case: &fricont_exchange::io::CaseData,
     problem: Arc<fricont::Problem>,
     (amp, omega): (f64, f64),
     tol: f64,
-) -> (usize, f64) {
+) -> (usize, usize, f64) {
     sine_against_reference(case, problem, (amp, omega), false, tol)
 }
 
@@ -408,7 +408,7 @@ fn sine_against_reference(
     (amp, omega): (f64, f64),
     basis: bool,
     tol: f64,
-) -> (usize, f64) {
+) -> (usize, usize, f64) {
     let c = compare_with_fricont(
         &condensed(case),
         problem.clone(),
@@ -420,22 +420,6 @@ fn sine_against_reference(
         &mut no_progress(),
     );
     c.check(tol).expect("the affine load against the reference");
-    // φ runs 0 → A → −A → A → −A → 0.
-    let aff = ref_events(&c.reference);
-    let up = |keep: &dyn Fn(f64) -> bool| -> Vec<Ev> {
-        aff.iter().filter(|e| keep(e.0)).copied().collect()
-    };
-    let down = || -> Vec<Ev> {
-        aff.iter()
-            .rev()
-            .map(|&(phi, node, from, to)| (phi, node, to, from))
-            .collect()
-    };
-    let mut want = up(&|phi| phi > 0.0);
-    want.extend(down());
-    want.extend(up(&|_| true));
-    want.extend(down());
-    want.extend(up(&|phi| phi < 0.0));
     let (f0, f1) = (case.f0.clone(), case.f1.clone());
     let load = if basis {
         let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
@@ -468,8 +452,70 @@ fn sine_against_reference(
         .iter()
         .map(|e| (amp * (omega * e.alpha).sin(), e.node, e.from, e.to))
         .collect();
+    let (want, folds) = sine_walk(&c.reference, &path.pieces()[0].classes, amp);
     let worst = compare_events(&got, &want, tol).unwrap_or_else(|e| panic!("{e}"));
-    (got.len(), worst)
+    let got_folds = path.events().iter().filter(|e| e.fold).count();
+    assert_eq!(got_folds, folds, "folds: fricont's against the walk's");
+    (got.len(), folds, worst)
+}
+
+/// The reference's events met under the load `f0 + A sin(ω α) f1`, α from 0 over two
+/// periods, in φ = A sin(ω α), and the number of folds among them. The solutions at α
+/// are those of the affine load at φ(α), so the path walks the reference's curve C
+/// (traced from φ = −A to the window's end, folds included), from the piece of C of
+/// classes `start` that contains φ = 0, the way φ rises. It turns back along C where φ
+/// turns (at ±A; the events met on the way back with their classes swapped), and keeps
+/// its way along C through a fold of C, where α turns instead. It ends where α leaves
+/// [0, 4π/ω] (φ back at 0).
+fn sine_walk(tr: &common::reference::RefTrace, start: &[Class], amp: f64) -> (Vec<Ev>, usize) {
+    let pcs = &tr.pieces;
+    let mut found = pcs.iter().enumerate().filter(|(_, (cls, a, b))| {
+        cls.as_slice() == start && a.min(*b) <= 0.0 && a.max(*b) >= 0.0 && a != b
+    });
+    let (mut j, _) = found
+        .next()
+        .expect("a piece of C at φ = 0 with fricont's start classes");
+    assert!(
+        found.next().is_none(),
+        "two pieces of C at φ = 0 with the start classes"
+    );
+    // Along C: +1 towards the later pieces. Along α: +1 forward, in φ's monotone
+    // stretch `k` (0 → A, A → −A, −A → A, A → −A, −A → 0), whose ends are at φ = ends.
+    let mut dir = if pcs[j].2 > pcs[j].1 { 1 } else { -1 };
+    let (mut way, mut k, mut s) = (1i32, 0usize, 0.0f64);
+    let ends = [0.0, amp, -amp, amp, -amp, 0.0];
+    let (mut out, mut folds) = (Vec::new(), 0);
+    loop {
+        let target = ends[if way > 0 { k + 1 } else { k }];
+        let vertex = if dir > 0 { pcs[j].2 } else { pcs[j].1 };
+        let at_end_of_c = (j == 0 && dir < 0) || (j + 1 == pcs.len() && dir > 0);
+        if target != s
+            && (target - s) * (vertex - target) >= 0.0
+            && (target != vertex || at_end_of_c)
+        {
+            // φ turns: α passes its extremum (or leaves the window), C is walked back.
+            if (way < 0 && k == 0) || (way > 0 && k == 4) {
+                return (out, folds);
+            }
+            k = if way > 0 { k + 1 } else { k - 1 };
+            dir = -dir;
+            s = target;
+            continue;
+        }
+        assert!(!at_end_of_c, "the walk left C at φ = {vertex}");
+        let e = &tr.events[if dir > 0 { j } else { j - 1 }];
+        out.push(if dir > 0 {
+            (e.alpha, e.node, e.from, e.to)
+        } else {
+            (e.alpha, e.node, e.to, e.from)
+        });
+        if e.fold {
+            way = -way;
+            folds += 1;
+        }
+        j = if dir > 0 { j + 1 } else { j - 1 };
+        s = vertex;
+    }
 }
 
 /// A general load in double alone on a moderately slender body (67 × 6 nodes on
@@ -496,7 +542,7 @@ fn general_load_in_double_on_a_moderately_slender_body() {
         .extended_precision(fricont::ExtendedPrecision::Off)
         .build()
         .expect("problem");
-    let (n, worst) = sine_general_against_reference(&case, Arc::new(double), (1.5, 500.0), 1e-9);
+    let (n, _, worst) = sine_general_against_reference(&case, Arc::new(double), (1.5, 500.0), 1e-9);
     assert_eq!(n, 664);
     eprintln!("{n} events, worst {worst:e} in φ");
 }
@@ -521,7 +567,7 @@ fn general_load_root_on_the_step_before() {
     );
     let problem = case.problem(None).expect("problem");
     assert!(problem.extended_precision());
-    let (n, worst) = sine_general_against_reference(&case, Arc::new(problem), (1.5, 50.0), 1e-9);
+    let (n, _, worst) = sine_general_against_reference(&case, Arc::new(problem), (1.5, 50.0), 1e-9);
     assert_eq!(n, 964);
     eprintln!("{n} events, worst {worst:e} in φ");
 }
@@ -581,7 +627,7 @@ fn general_load_through_a_nearly_singular_slip_piece() {
     let case = moderately_ill_conditioned_rectangle();
     let problem = Arc::new(case.problem(None).expect("problem"));
     assert!(problem.extended_precision());
-    let (events, worst) = sine_general_against_reference(&case, problem, (1.5, 500.0), 1e-9);
+    let (events, _, worst) = sine_general_against_reference(&case, problem, (1.5, 500.0), 1e-9);
     eprintln!("{events} events, worst {worst:e} in φ");
     assert!(events >= 12, "{events} events");
 }
@@ -621,9 +667,58 @@ fn basis_load_re_closing_at_a_shallow_angle() {
         let case = rect_case(json);
         let problem = Arc::new(case.problem(None).expect("problem"));
         assert!(problem.extended_precision());
-        let (events, worst) = sine_against_reference(&case, problem, (1.5, omega), true, 1e-12);
+        let (events, _, worst) = sine_against_reference(&case, problem, (1.5, omega), true, 1e-12);
         eprintln!("{events} events, worst {worst:e} in φ");
         assert!(events >= 8, "{events} events");
+    }
+}
+
+/// Sine loads through folds (extended precision): two rectangles with F = 5 whose affine
+/// paths fold (2 and 6 times), under `f0 + 1.5 sin(50 α) f1` over two periods (8 and 24
+/// folds in α), as basis and as general loads. All events and folds against the
+/// reference's affine events walked through the sine ([`sine_walk`]), to 1e-10 in φ
+/// (measured: 1.2e-12 and 5.1e-13 on the first, 2.1e-13 and 5.1e-12 on the second).
+/// Before, on the first (73 × 2), one slip+ → stick of each load was 1.9e-9 (basis) and
+/// 5.1e-9 (general) off: on its nearly singular pieces the basis load's point at the root
+/// was accepted at a residual of 1.4e-13, above rounding level, unseen by the estimate
+/// of its guard's rounding; and the general load's refined points were refused where the
+/// double points had the smaller residual against the double q, itself off by κ(A) ε.
+/// On the second (46 × 3, κ(W) = 1.2e6) the affine start failed ("node 45 fits no class
+/// at the computed point": the fixed-α solver's point, accurate to 1e-12, missed a
+/// stick node's dt threshold, 8.8e-14 against 7.6e-14), and the basis load stopped
+/// loudly at a fold ("no neighbouring piece continues the path"): there the guard's slope
+/// per unit α was 1e4, neighbouring doubles of α straddled its root at ±2.5e-14, and
+/// from slip the node's λt = F λν missed the open class's threshold.
+#[test]
+fn sine_loads_through_folds() {
+    for json in [
+        r#"{"nx": 73, "ny": 2, "lx": 7.470730077265378, "ly": 0.14197954422211922,
+            "friction": 5.0,
+            "load0": [{"side": "top", "start": [-0.008060823644532667, -0.003123978454574293],
+                       "end": [0.0016512907263668674, -0.00984205832953382]}],
+            "load1": [{"side": "top", "start": [-0.0006778220404474247, -0.005137850209621177],
+                       "end": [-0.006657371680741098, -0.008832081022064802]},
+                      {"side": "right", "start": [-0.007960830746318585, 0.004546274767610858],
+                       "end": [-0.002368293407820978, -0.000581164224198398]}]}"#,
+        r#"{"nx": 46, "ny": 3, "lx": 3.690879026345725, "ly": 0.12774440661181763,
+            "friction": 5.0,
+            "load0": [{"side": "top", "start": [0.00482296444443093, -0.0027098093843658335],
+                       "end": [0.004671291238201161, -0.007381918471102959]}],
+            "load1": [{"side": "top", "start": [0.008347701675210274, -0.00041624153873609515],
+                       "end": [-0.008076804193988074, 0.0076737724105035]}]}"#,
+    ] {
+        let case = rect_case(json);
+        let problem = Arc::new(case.problem(None).expect("problem"));
+        assert!(problem.extended_precision());
+        for basis in [true, false] {
+            let (events, folds, worst) =
+                sine_against_reference(&case, problem.clone(), (1.5, 50.0), basis, 1e-10);
+            eprintln!("basis {basis}: {events} events, {folds} folds, worst {worst:e} in φ");
+            assert!(
+                events >= 600 && folds >= 8,
+                "{events} events, {folds} folds"
+            );
+        }
     }
 }
 

@@ -227,19 +227,22 @@ impl Path {
         (rel, d, r)
     }
 
-    /// In extended precision, the root of guard `g` (row `k` of the piece's guard
-    /// table, slope `slope` per unit α) of the piece `cur` under a basis load corrected
-    /// on the point refined in double-double. A point rounded to double carries the rounding of its
-    /// terms in each d (ε |W||λ|): where the guard crosses at a shallow angle against
-    /// them, that moves the root by about ε |terms| / slope (4e-9 in φ where a node
-    /// re-closed at a slope of 5e-8 of its terms), while the refined d is accurate to the
-    /// data. So where that estimate exceeds 1e-12 of the window, `pt` is refined, and the
-    /// root moved by one Newton step on the refined guard, the point with it along the
-    /// piece's tangent (`bs` at α: a step of that rounding's size, whose own error is its
-    /// square). `per_tol`: the roundings of a guard's terms that count, as a fraction of
-    /// its zero threshold (64 ε / `zero_tol`, as for the march's roots). None when the
-    /// problem is carried in double, the root is well determined in double, or the
-    /// refinement fails or lands beyond that rounding.
+    /// In extended precision, the root of guard `g` (row `k` of the piece's guard table,
+    /// slope `slope` per unit α) of the piece `cur` under a basis load corrected on the
+    /// point refined in double-double. A point rounded to double carries the rounding of
+    /// its terms in each d (ε |W||λ|), and more where it was accepted at a residual above
+    /// rounding level (up to a solve's check, 1e-12; 1.4e-13 on a nearly singular piece
+    /// near a fold). Where the guard crosses at a shallow angle against its terms, that
+    /// moves the root by about ε |terms| / slope, or that residual's share of the terms
+    /// over the slope (4e-9 in φ where a node re-closed at a slope of 5e-8 of its terms;
+    /// 1.9e-9 where a node stuck again near a fold), while the refined d is accurate to
+    /// the data. So where that estimate (from the point's measured residual) exceeds 1e-12
+    /// of the window, `pt` is refined, and the root moved by one Newton step on the
+    /// refined guard, the point with it along the piece's tangent (`bs` at α: a step of
+    /// that error's size, whose own error is its square). `per_tol`: the roundings of a
+    /// guard's terms that count, as a fraction of its zero threshold (64 ε / `zero_tol`,
+    /// as for the march's roots). None when the problem is carried in double, the root is
+    /// well determined in double, or the refinement fails or lands beyond that error.
     fn polish_root(
         &mut self,
         cur: &CurrentPiece,
@@ -251,26 +254,35 @@ impl Path {
         if !self.problem.extended_precision() {
             return Ok(None);
         }
-        let roundings = per_tol * self.tol_at(pt).of(&self.consts().guard_form(g));
+        let per_rounding = per_tol * self.tol_at(pt).of(&self.consts().guard_form(g));
         let bound = 1e-12 * self.alpha_scale() * slope.abs();
-        if roundings.partial_cmp(&bound) != Some(std::cmp::Ordering::Greater) {
+        let above = |x: f64| x.partial_cmp(&bound) == Some(std::cmp::Ordering::Greater);
+        // `pt` may have been accepted at a residual up to a solve's check (1e-12), above
+        // rounding level: its guards then carry that much more of their terms. Measured
+        // (one product with W) only where a residual that large could matter.
+        if !above(per_rounding * (1e-12 / f64::EPSILON)) {
+            return Ok(None);
+        }
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+        let rel = self.point_residual(&cur.classes, &qg, &pt.lam).0;
+        let error = per_rounding * (rel / f64::EPSILON).max(1.0);
+        if !above(error) {
             return Ok(None);
         }
         let Some((lam, d)) = self.polish_point(&cur.classes, &cur.lu, pt.alpha, &pt.lam) else {
             return Ok(None);
         };
-        // A step within the window, of the size of the rounding it corrects (more means
-        // a refinement that did not land near this root: `pt` is kept).
+        // A step within the window, of the size of the error it corrects (more means a
+        // refinement that did not land near this root: `pt` is kept).
         let v = self.guard_rows(&cur.classes, &lam, &d, None)[k].value;
         let (lo, hi) = self.window();
         let step = (pt.alpha - v / slope).clamp(lo, hi) - pt.alpha;
-        if v.abs() > roundings || !step.is_finite() {
+        if v.abs() > error || !step.is_finite() {
             return Ok(None);
         }
         let Some((w, dw)) = self.load.weights_at(pt.alpha) else {
             return Ok(None);
         };
-        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
         let lam: Vec<f64> = lam.iter().zip(&t).map(|(l, t)| l + step * t).collect();
         let d: Vec<f64> = d.iter().zip(&rate).map(|(x, r)| x + step * r).collect();
@@ -1002,7 +1014,19 @@ impl Path {
                 let (lo_a, hi_a) = (from.min(pb.alpha), from.max(pb.alpha));
                 let (mut x0, mut v0) = (root, tab[k].value);
                 let slope = tab[k].slope;
-                let accept = 0.25 * self.tol_at(&pt).of(&self.consts().guard_form(g));
+                // A quarter of the guard's threshold; for a normal force, that over F:
+                // from slip, λt = ±F λν follows it, and the classes the node may take
+                // bound λt by the same threshold (with F = 5, λν at 0.65 of it left λt
+                // beyond the open class's, and no piece continued the path).
+                let (form, amplified) = {
+                    let c = self.consts();
+                    let f = match g.kind {
+                        crate::piece::GuardKind::Compress => c.friction[g.node].max(1.0),
+                        _ => 1.0,
+                    };
+                    (c.guard_form(g), f)
+                };
+                let accept = 0.25 * self.tol_at(&pt).of(&form) / amplified;
                 let mut bracket = None;
                 let mut best: Option<Point> = None;
                 let mut step = -v0 / slope;
@@ -1053,6 +1077,31 @@ impl Path {
                     } else {
                         eval(self, p.alpha, true)?.0
                     };
+                }
+                // Where α cannot resolve the root (near a fold the guard's slope per unit
+                // α was 1e4: neighbouring doubles of α straddled it at ±2.5e-14, above
+                // `accept`), the point is moved along the piece's tangent to the guard's
+                // zero, λ and d by the Newton step, α by it rounded.
+                let v = form.eval(&pt.lam, &self.gaps(&pt));
+                if v.abs() > accept
+                    && let Some((w, dw)) = self.load.weights_at(pt.alpha)
+                {
+                    let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+                    let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
+                    let step = -v / form.eval(&t, &rate);
+                    if step.is_finite() && (pt.alpha + step).clamp(lo_a, hi_a) == pt.alpha + step {
+                        let lam: Vec<f64> =
+                            pt.lam.iter().zip(&t).map(|(l, t)| l + step * t).collect();
+                        let d: Vec<f64> = self
+                            .gaps(&pt)
+                            .iter()
+                            .zip(&rate)
+                            .map(|(x, r)| x + step * r)
+                            .collect();
+                        let alpha = pt.alpha + step;
+                        self.prime_gaps(alpha, &lam, d);
+                        pt = self.point_at(lam, alpha)?;
+                    }
                 }
                 if let Some(p) = self.polish_root(cur, bs, (k, g, slope), roundings, &pt)? {
                     pt = p;

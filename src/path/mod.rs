@@ -1328,12 +1328,25 @@ impl Path {
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let guess = guess.map(|g| self.lam_to_internal(g));
         let lam = solve_fixed_alpha(&self.problem, &qg, guess.as_deref(), alpha)?;
-        let pt = Point { lam, ..pt };
-        let tol = self.tol_at(&pt);
+        let mut pt = Point { lam, ..pt };
+        let mut tol = self.tol_at(&pt);
         let p = self.problem.p();
         let mut fixed = vec![Class::Open; p];
         let mut nodes = Vec::new();
-        let all = self.compatible(&(0..p).collect::<Vec<_>>(), &pt, &tol);
+        let every: Vec<usize> = (0..p).collect();
+        let mut all = self.compatible(&every, &pt, &tol);
+        // The fixed-α solver's point is accurate to its residual (1e-12 of each node's
+        // scale) only, and on an ill-conditioned W a row whose terms are small can miss
+        // its threshold by that (a stick node's dt at 8.8e-14 against 7.6e-14, κ(W) =
+        // 1.2e6): in extended precision the point is then solved again on its piece (the
+        // classes of the solver's last Newton step) from the data, in double-double.
+        if all.iter().any(Vec::is_empty)
+            && let Some(lam) = self.start_on_its_piece(&pt, &qg)
+        {
+            pt.lam = lam;
+            tol = self.tol_at(&pt);
+            all = self.compatible(&every, &pt, &tol);
+        }
         for (i, comp) in all.into_iter().enumerate() {
             match comp.len() {
                 0 => {
@@ -1404,6 +1417,29 @@ impl Path {
     fn begin_afresh(&mut self, pt: &Point, cand: Candidate, want: i8) -> Result<()> {
         *self.updater.borrow_mut() = None;
         self.begin(pt, cand, want)
+    }
+
+    /// The fixed-α solver's point `pt` (`qg = q(α) − (g, 0)`) solved again on the piece
+    /// of its projection classes and refined in double-double, its d kept for
+    /// [`Self::gaps`]. None in double, on a vertical piece, or when the refinement fails.
+    fn start_on_its_piece(&mut self, pt: &Point, qg: &[f64]) -> Option<Vec<f64>> {
+        if !self.problem.extended_precision() {
+            return None;
+        }
+        let classes = crate::solve::active_classes(
+            &self.consts(),
+            self.problem.delassus().w(),
+            qg,
+            &pt.lam,
+            None,
+        );
+        let piece = self.tangent(&classes, pt, self.force_scale(pt))?;
+        if piece.scales.is_vertical(&piece.t) {
+            return None;
+        }
+        let (lam, d) = self.polish_point(&classes, &piece.lu, pt.alpha, &pt.lam)?;
+        self.prime_gaps(pt.alpha, &lam, d);
+        Some(lam)
     }
 
     /// Starts the trace at `pt` on candidate `cand` (`want`: the sign of α's way toward
