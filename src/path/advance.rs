@@ -284,11 +284,29 @@ impl Path {
             return Ok(None);
         };
         let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
-        let lam: Vec<f64> = lam.iter().zip(&t).map(|(l, t)| l + step * t).collect();
-        let d: Vec<f64> = d.iter().zip(&rate).map(|(x, r)| x + step * r).collect();
-        let alpha = pt.alpha + step;
+        Ok(Some(self.step_along(
+            pt.alpha,
+            (&lam, &d),
+            (&t, &rate),
+            step,
+        )?))
+    }
+
+    /// The point `(λ, d)` at `alpha` moved along its piece's tangent `(t, rate)` (per
+    /// unit α: dλ/dα and the rate of d, as [`BasisSolutions::at`] gives them) by `step`
+    /// in α, its d kept for [`Self::gaps`]. Errors: the load's at the new α.
+    fn step_along(
+        &mut self,
+        alpha: f64,
+        (lam, d): (&[f64], &[f64]),
+        (t, rate): (&[f64], &[f64]),
+        step: f64,
+    ) -> Result<Point> {
+        let lam: Vec<f64> = lam.iter().zip(t).map(|(l, t)| l + step * t).collect();
+        let d: Vec<f64> = d.iter().zip(rate).map(|(x, r)| x + step * r).collect();
+        let alpha = alpha + step;
         self.prime_gaps(alpha, &lam, d);
-        Ok(Some(self.point_at(lam, alpha)?))
+        self.point_at(lam, alpha)
     }
 
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
@@ -1082,7 +1100,8 @@ impl Path {
                 // α was 1e4: neighbouring doubles of α straddled it at ±2.5e-14, above
                 // `accept`), the point is moved along the piece's tangent to the guard's
                 // zero, λ and d by the Newton step, α by it rounded.
-                let v = form.eval(&pt.lam, &self.gaps(&pt));
+                let d = self.gaps(&pt);
+                let v = form.eval(&pt.lam, &d);
                 if v.abs() > accept
                     && let Some((w, dw)) = self.load.weights_at(pt.alpha)
                 {
@@ -1090,17 +1109,7 @@ impl Path {
                     let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
                     let step = -v / form.eval(&t, &rate);
                     if step.is_finite() && (pt.alpha + step).clamp(lo_a, hi_a) == pt.alpha + step {
-                        let lam: Vec<f64> =
-                            pt.lam.iter().zip(&t).map(|(l, t)| l + step * t).collect();
-                        let d: Vec<f64> = self
-                            .gaps(&pt)
-                            .iter()
-                            .zip(&rate)
-                            .map(|(x, r)| x + step * r)
-                            .collect();
-                        let alpha = pt.alpha + step;
-                        self.prime_gaps(alpha, &lam, d);
-                        pt = self.point_at(lam, alpha)?;
+                        pt = self.step_along(pt.alpha, (&pt.lam, &d), (&t, &rate), step)?;
                     }
                 }
                 if let Some(p) = self.polish_root(cur, bs, (k, g, slope), roundings, &pt)? {
