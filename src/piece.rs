@@ -352,7 +352,7 @@ struct Reduction {
 
 impl DenseLu {
     pub fn new(a: MatRef<'_, f64>) -> Self {
-        Self::from_lu(crate::dense::partial_piv_lu(a), None)
+        Self::from_lu(crate::dense::partial_piv_lu(a.to_owned()), None)
     }
 
     /// The LU of the matrix whose row `r` is the linear form `rows[r]` over λ (W
@@ -435,7 +435,7 @@ impl DenseLu {
             dl,
             ld,
         };
-        Self::from_lu(crate::dense::partial_piv_lu(s.as_ref()), Some(red))
+        Self::from_lu(crate::dense::partial_piv_lu(s), Some(red))
     }
 
     /// Sign and pivot ratio from the LU's pivots and permutation with the eliminated

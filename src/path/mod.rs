@@ -253,6 +253,9 @@ pub struct Path {
     gaps_cache: RefCell<Vec<GapsAt>>,
     /// The last point's "at zero" thresholds with its (α, λ).
     tol_cache: RefCell<Option<(f64, Vec<f64>, Tol)>>,
+    /// The last few force scales with their (α, λ): a transition reads those of its point
+    /// and of the point it came from several times, each an O(m) scan.
+    scale_cache: RefCell<Vec<(f64, Vec<f64>, f64)>>,
     /// The last step (α units) that the march of a nonlinear load trusted: the next
     /// piece's march starts from twice that, not from the window's scale.
     graph_step: Cell<Option<f64>>,
@@ -668,6 +671,7 @@ impl Path {
             refactorisations: Cell::new(0),
             gaps_cache: RefCell::new(Vec::new()),
             tol_cache: RefCell::new(None),
+            scale_cache: RefCell::new(Vec::new()),
             graph_step: Cell::new(None),
         })
     }
@@ -719,16 +723,31 @@ impl Path {
     /// foundation does not set the scale of the others. For affine and basis loads it
     /// depends on the point alone, never on the window.
     fn force_scale(&self, pt: &Point) -> f64 {
+        if let Some((_, _, s)) = self
+            .scale_cache
+            .borrow()
+            .iter()
+            .find(|(a, lam, _)| *a == pt.alpha && *lam == pt.lam)
+        {
+            return *s;
+        }
         let r0 = self.problem.default_r();
         let terms = self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b));
         let overlap =
             pt.q.iter()
                 .zip(self.problem.gap_equilibrated())
                 .fold(0.0f64, |a, (q, g)| a.max(q - g));
-        inf_norm(&pt.lam)
+        let scale = inf_norm(&pt.lam)
             .max(r0 * terms)
             .max(r0 * overlap)
-            .max(1e-300)
+            .max(1e-300);
+        const KEEP: usize = 4;
+        let mut cache = self.scale_cache.borrow_mut();
+        if cache.len() == KEEP {
+            cache.remove(0);
+        }
+        cache.push((pt.alpha, pt.lam.clone(), scale));
+        scale
     }
 
     /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
