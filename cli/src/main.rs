@@ -354,6 +354,20 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
             problem.w_condition_estimate(),
             problem.delassus().setup_times().w_lo_s
         );
+    } else if !problem.extended_precision()
+        && problem.w_condition_estimate() > fricont::problem::AUTO_CONDITION
+    {
+        // An ill-conditioned W traced in double: say so, with what it costs in accuracy.
+        let kappa = problem.w_condition_estimate();
+        eprintln!(
+            "fricont: note: W is ill-conditioned (condition estimate {kappa:.1e}) and traced in double{}: its rounding can move transition points by up to about {:.0e} (50 x condition x 1.1e-16) relative to max(1, |alpha|); --extended-precision on refines it",
+            if matches!(args.extended_precision, Extended::Auto) {
+                " (auto refines only where that costs at most max(20 x the factorisation of A, 1e11) operations)"
+            } else {
+                ""
+            },
+            50.0 * kappa * f64::EPSILON / 2.0
+        );
     }
     let load = case
         .load()

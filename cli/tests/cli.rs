@@ -1190,3 +1190,69 @@ fn start_bifurcation_is_reported() {
         stdout(&o)
     );
 }
+
+/// An ill-conditioned W traced in double is never silent. A slender strip (59 contact
+/// nodes on 6 × 0.1, W's condition estimate about 9e6): with `--extended-precision off`
+/// stderr says that W is ill-conditioned and traced in double, and the JSON's `precision`
+/// says the same; with `auto` (a small problem: refined) the note is the refinement's and
+/// `precision.extended` is true. The double events stay within the bound the note and
+/// docs/json-report.md state, 50 × condition × 1.1e-16 relative to max(1, |α|), of the
+/// refined ones (the same nodes and classes).
+#[test]
+fn ill_conditioned_w_in_double_is_reported() {
+    let tmp = TempDir::new("illcond");
+    let dir = tmp.path().join("strip");
+    let o = run(&[
+        "gen-rect",
+        "--press-shear",
+        "--nx",
+        "60",
+        "--ny",
+        "3",
+        "--lx",
+        "6",
+        "--ly",
+        "0.1",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let trace = |mode: &str| -> (String, Value) {
+        let json = tmp.path().join(format!("{mode}.json"));
+        let o = run(&[
+            "trace",
+            dir.to_str().unwrap(),
+            "--extended-precision",
+            mode,
+            "--json",
+            json.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        let v = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        (stderr(&o), v)
+    };
+    let (err_off, off) = trace("off");
+    let (err_auto, auto) = trace("auto");
+    let kappa = off["precision"]["w_condition_estimate"].as_f64().unwrap();
+    assert!(kappa > 1e6, "condition estimate {kappa:e}");
+    assert_eq!(off["precision"]["extended"], Value::Bool(false));
+    assert!(
+        err_off.contains("W is ill-conditioned (condition estimate") && err_off.contains("double"),
+        "{err_off}"
+    );
+    assert_eq!(auto["precision"]["extended"], Value::Bool(true));
+    assert!(
+        err_auto.contains("refined beyond double") && !err_auto.contains("ill-conditioned"),
+        "{err_auto}"
+    );
+    let (a, b) = (event_list(&off), event_list(&auto));
+    assert!(a.len() > 50, "{} events", a.len());
+    assert_eq!(a.len(), b.len());
+    let bound = 50.0 * kappa * f64::EPSILON / 2.0;
+    for (x, y) in a.iter().zip(&b) {
+        assert_eq!((x.1, &x.2, &x.3), (y.1, &y.2, &y.3));
+        assert!(
+            (x.0 - y.0).abs() <= bound * x.0.abs().max(1.0),
+            "{x:?} {y:?}: beyond {bound:e}"
+        );
+    }
+}

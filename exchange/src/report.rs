@@ -85,7 +85,8 @@ fn ser_opt_num<S: serde::Serializer>(x: &Option<f64>, s: S) -> Result<S::Ok, S::
 /// `start {alpha, classes, residual}`, `events [{index, alpha, node, from, to, fold,
 /// bifurcation, residual}]` (index and node 1-based), `pieces [{alpha_from, alpha_to,
 /// classes}]`, `end {alpha, reason}`, `timing {setup_s, trace_s}`. Extra keys: `F`
-/// (number when uniform, else array), `start.lambda_n`, `start.lambda_t`, per event
+/// (number when uniform, else array), `precision {extended, w_condition_estimate}`,
+/// `start.lambda_n`, `start.lambda_t`, per event
 /// `transition` (1-based transition point) and the node's `lambda_n`, `lambda_t` at the
 /// event, per piece `direction` (sign of dα/ds, 0 for a vertical piece), `orientation`,
 /// `det_sign`, `end.message` for a failure, `end.branches` for a bifurcation stop, and
@@ -108,6 +109,8 @@ pub struct PathReport {
     /// Friction: a number when uniform, else one per node.
     #[serde(rename = "F")]
     pub friction: Value,
+    /// The precision W and the loads were traced in, with W's condition estimate.
+    pub precision: PrecisionReport,
     /// The start point (`null` if the path was never started).
     pub start: Option<StartReport>,
     /// One per event, in path order.
@@ -226,6 +229,19 @@ pub struct BranchReport {
     pub orientation_preserving: bool,
 }
 
+/// The precision of a [`PathReport`]'s path: whether W and the condensed loads were carried
+/// beyond double (`Problem::extended_precision`), and the estimate of the 2-norm condition
+/// number of the equilibrated W (`Problem::w_condition_estimate`, dimensionless): in double,
+/// the rounding of W moves transition points by up to about that times ε relative.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct PrecisionReport {
+    /// Traced in extended precision.
+    pub extended: bool,
+    /// Condition estimate of the equilibrated W.
+    #[serde(serialize_with = "ser_num")]
+    pub w_condition_estimate: f64,
+}
+
 /// Timing in a [`PathReport`], seconds.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct TimingReport {
@@ -325,6 +341,10 @@ impl PathReport {
             alpha_start: opts.alpha_start,
             alpha_end: opts.alpha_end,
             friction,
+            precision: PrecisionReport {
+                extended: problem.extended_precision(),
+                w_condition_estimate: problem.w_condition_estimate(),
+            },
             start,
             n_events: events.len(),
             n_transitions: events.last().map_or(0, |e| e.transition),

@@ -352,6 +352,24 @@ class Problem:
         """The augmentation parameter in use (force per length)."""
         return self._core.r
 
+    @property
+    def extended_precision(self) -> bool:
+        """Whether W and the condensed loads are carried beyond double precision.
+
+        Chosen automatically: small problems always, and problems whose W is
+        ill-conditioned (``w_condition_estimate`` above 1e6) where the refinement costs at
+        most max(20 times the factorisation of A, 1e11) operations. When False, the rounding
+        of W moves transition points by up to about 50 * ``w_condition_estimate`` * 1.1e-16,
+        relative to max(1, abs(alpha)).
+        """
+        return self._core.extended_precision
+
+    @property
+    def w_condition_estimate(self) -> float:
+        """Estimate of the 2-norm condition number of the equilibrated W (dimensionless,
+        usually a lower bound; W's rows are equilibrated by powers of two)."""
+        return self._core.w_condition_estimate
+
     def trace(
         self,
         f0=None,

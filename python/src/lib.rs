@@ -202,6 +202,20 @@ impl Problem {
         self.inner.r()
     }
 
+    /// Whether W and the condensed loads are carried beyond double (`auto`: small problems,
+    /// and ill-conditioned W where the refinement's cost is moderate; see
+    /// `fricont.Problem.extended_precision`).
+    #[getter]
+    fn extended_precision(&self) -> bool {
+        self.inner.extended_precision()
+    }
+
+    /// Estimate of the 2-norm condition number of the equilibrated W (dimensionless).
+    #[getter]
+    fn w_condition_estimate(&self) -> f64 {
+        self.inner.w_condition_estimate()
+    }
+
     /// Friction coefficients (p).
     #[getter]
     fn friction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {

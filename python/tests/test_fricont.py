@@ -79,6 +79,13 @@ def test_one_node_sticks_then_slips_at_the_hand_derived_alpha():
     for bad in (float("nan"), float("inf")):
         with pytest.raises(ValueError, match="not finite"):
             path.solutions_at(bad)
+    # W = B A^-1 B^T = diag(1/2, 1) (rows of norm 1: no equilibration): condition 2 (its
+    # estimate by 20 power iterations, a lower bound, to about 4^-20); a problem this small
+    # is always refined, and the report says both.
+    assert prob.w_condition_estimate == pytest.approx(2.0, rel=1e-9)
+    assert prob.extended_precision is True
+    assert path.to_dict()["precision"] == {
+        "extended": True, "w_condition_estimate": prob.w_condition_estimate}
 
 
 def test_sample_events_equal_the_cli(sample, tmp_path):
