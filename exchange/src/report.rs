@@ -232,7 +232,8 @@ pub struct BranchReport {
 /// The precision of a [`PathReport`]'s path: whether W and the condensed loads were carried
 /// beyond double (`Problem::extended_precision`), and the estimate of the 2-norm condition
 /// number of the equilibrated W (`Problem::w_condition_estimate`, dimensionless): in double,
-/// the rounding of W moves transition points by up to about that times ε relative.
+/// the rounding of W moves transition points by up to about 50 times that times ε,
+/// relative to max(1, |α|) (see `docs/json-report.md`).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct PrecisionReport {
     /// Traced in extended precision.
