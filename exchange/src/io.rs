@@ -114,7 +114,8 @@ impl CaseData {
     /// stored, an array otherwise), `alpha_start`, `alpha_end` from the fields, and every
     /// other key of [`CaseData::meta`]. `gap.txt` is written only when a gap is present
     /// (a stale `gap.txt` is removed otherwise). Errors: [`Error::Io`] for a failed write,
-    /// [`Error::Dimension`] when the fields disagree with each other.
+    /// [`Error::Core`] (a `fricont::Error::Dimension`) when the fields disagree with each
+    /// other.
     pub fn write_dir(&self, dir: &std::path::Path) -> Result<()> {
         self.check_dims()?;
         std::fs::create_dir_all(dir)

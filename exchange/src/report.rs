@@ -18,7 +18,7 @@ use fricont::path::{EndReason, Event, Path};
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Timing {
     /// Set-up: validation, sparse Cholesky of A, the Delassus operator W and the condensed
-    /// load vectors (building the [`crate::Problem`] and the [`Path`]).
+    /// load vectors (building the [`fricont::Problem`] and the [`Path`]).
     pub setup_s: f64,
     /// Tracing: the start solve and every step ([`Path::start`] + [`Path::run`]).
     pub trace_s: f64,
