@@ -210,6 +210,22 @@ fn mirror_pairs_with_centre_node() {
     );
 }
 
+/// The mirror-symmetric finite-element body of `seed` ([`common::symmetric_fe_case`],
+/// 4–27 × 1–4 elements, F from 0.1 to 5), its last contact node's index nx (the nodes are
+/// 0 … nx), and a description for messages.
+fn mirror_body(seed: u64) -> (Case, usize, String) {
+    let mut rng = common::Rng::new(seed);
+    let nx = 2 * (2 + rng.int(0, 11)) + (seed % 2) as usize;
+    let ny = rng.int(1, 4);
+    let friction = [0.1, 0.3, 0.8, 1.5, 3.0, 5.0][rng.int(0, 5)];
+    let case = common::symmetric_fe_case(seed, nx, ny, friction);
+    (
+        case,
+        nx,
+        format!("seed {seed} (nx = {nx}, ny = {ny}, F = {friction})"),
+    )
+}
+
 /// On a mirror-symmetric body with contact nodes 0 … nx: every event of a node off the
 /// axis has its mirror image (node nx − i, the same α to 1e-9, S+ and S− swapped), and the
 /// centre node never enters slip. Returns the number of events off the axis.
@@ -251,13 +267,8 @@ fn assert_mirrored(ctx: &str, ev: &[(f64, usize, Class, Class)], nx: usize) -> u
 fn mirror_symmetric_bodies_under_an_oscillating_load() {
     let (mut windows, mut pairs) = (0, 0);
     for seed in 0..24u64 {
-        let mut rng = common::Rng::new(seed);
-        let nx = 2 * (2 + rng.int(0, 11)) + (seed % 2) as usize;
-        let ny = rng.int(1, 4);
-        let friction = [0.1, 0.3, 0.8, 1.5, 3.0, 5.0][rng.int(0, 5)];
-        let case = common::symmetric_fe_case(seed, nx, ny, friction);
+        let (case, nx, ctx) = mirror_body(seed);
         let data = &case.data;
-        let ctx = format!("seed {seed} (nx = {nx}, ny = {ny}, F = {friction})");
         let omega = 50.0;
         let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
             w[0] = 1.0;
@@ -308,13 +319,8 @@ fn mirror_symmetric_finite_element_bodies() {
     use common::reference::{Condensed, compare_events, compare_with_fricont};
     let (mut windows, mut stops, mut pairs) = (0, 0, 0);
     for seed in 0..30u64 {
-        let mut rng = common::Rng::new(seed);
-        let nx = 2 * (2 + rng.int(0, 11)) + (seed % 2) as usize;
-        let ny = rng.int(1, 4);
-        let friction = [0.1, 0.3, 0.8, 1.5, 3.0, 5.0][rng.int(0, 5)];
-        let case = common::symmetric_fe_case(seed, nx, ny, friction);
+        let (case, nx, ctx) = mirror_body(seed);
         let data = &case.data;
-        let ctx = format!("seed {seed} (nx = {nx}, ny = {ny}, F = {friction})");
         let c = compare_with_fricont(
             &Condensed::from_data(data),
             Arc::new(data.problem()),
