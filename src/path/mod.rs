@@ -250,12 +250,12 @@ pub struct Path {
     /// The last few `d = q − (g, 0) + W λ` with their (α, λ): every candidate piece at a
     /// transition point needs the point's, and the ratio test on the piece taken needs
     /// that of the piece's own point (primed when it was solved for).
-    gaps_cache: RefCell<Vec<GapsAt>>,
+    gaps_cache: PointCache<Arc<Vec<f64>>>,
     /// The last point's "at zero" thresholds with its (α, λ).
     tol_cache: RefCell<Option<(f64, Vec<f64>, Tol)>>,
     /// The last few force scales with their (α, λ): a transition reads those of its point
     /// and of the point it came from several times, each an O(m) scan.
-    scale_cache: RefCell<Vec<(f64, Vec<f64>, f64)>>,
+    scale_cache: PointCache<f64>,
     /// The last step (α units) that the march of a nonlinear load trusted: the next
     /// piece's march starts from twice that, not from the window's scale.
     graph_step: Cell<Option<f64>>,
@@ -421,8 +421,36 @@ impl Tol {
     }
 }
 
-/// `d` at a point `(α, λ)`.
-type GapsAt = (f64, Vec<f64>, Arc<Vec<f64>>);
+/// Values computed at the last few points `(α, λ)`, found again by exact equality of α
+/// and λ (q, and so all the point's data, follows from α).
+struct PointCache<T>(RefCell<Vec<(f64, Vec<f64>, T)>>);
+
+impl<T: Clone> PointCache<T> {
+    /// Entries kept: a transition reads its point's, the point it came from, and the
+    /// points of the pieces it examines.
+    const KEEP: usize = 4;
+
+    fn new() -> Self {
+        Self(RefCell::new(Vec::new()))
+    }
+
+    fn get(&self, alpha: f64, lam: &[f64]) -> Option<T> {
+        self.0
+            .borrow()
+            .iter()
+            .find(|(a, l, _)| *a == alpha && l == lam)
+            .map(|(_, _, v)| v.clone())
+    }
+
+    /// Keeps `v` for `(alpha, lam)`, dropping the oldest entry beyond [`Self::KEEP`].
+    fn put(&self, alpha: f64, lam: &[f64], v: T) {
+        let mut cache = self.0.borrow_mut();
+        if cache.len() == Self::KEEP {
+            cache.remove(0);
+        }
+        cache.push((alpha, lam.to_vec(), v));
+    }
+}
 
 /// Position on the current piece.
 #[derive(Clone)]
@@ -669,9 +697,9 @@ impl Path {
             trace: None,
             updater: RefCell::new(None),
             refactorisations: Cell::new(0),
-            gaps_cache: RefCell::new(Vec::new()),
+            gaps_cache: PointCache::new(),
             tol_cache: RefCell::new(None),
-            scale_cache: RefCell::new(Vec::new()),
+            scale_cache: PointCache::new(),
             graph_step: Cell::new(None),
         })
     }
@@ -723,13 +751,8 @@ impl Path {
     /// foundation does not set the scale of the others. For affine and basis loads it
     /// depends on the point alone, never on the window.
     fn force_scale(&self, pt: &Point) -> f64 {
-        if let Some((_, _, s)) = self
-            .scale_cache
-            .borrow()
-            .iter()
-            .find(|(a, lam, _)| *a == pt.alpha && *lam == pt.lam)
-        {
-            return *s;
+        if let Some(s) = self.scale_cache.get(pt.alpha, &pt.lam) {
+            return s;
         }
         let r0 = self.problem.default_r();
         let terms = self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b));
@@ -741,12 +764,7 @@ impl Path {
             .max(r0 * terms)
             .max(r0 * overlap)
             .max(1e-300);
-        const KEEP: usize = 4;
-        let mut cache = self.scale_cache.borrow_mut();
-        if cache.len() == KEEP {
-            cache.remove(0);
-        }
-        cache.push((pt.alpha, pt.lam.clone(), scale));
+        self.scale_cache.put(pt.alpha, &pt.lam, scale);
         scale
     }
 
@@ -930,13 +948,8 @@ impl Path {
     /// `d = q − (g, 0) + W λ` at a point (one product with W, cached for the last few
     /// points).
     fn gaps(&self, pt: &Point) -> Arc<Vec<f64>> {
-        if let Some((_, _, d)) = self
-            .gaps_cache
-            .borrow()
-            .iter()
-            .find(|(a, lam, _)| *a == pt.alpha && *lam == pt.lam)
-        {
-            return d.clone();
+        if let Some(d) = self.gaps_cache.get(pt.alpha, &pt.lam) {
+            return d;
         }
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let d = displacement_gaps(self.problem.delassus().w(), &qg, &pt.lam);
@@ -945,13 +958,8 @@ impl Path {
 
     /// Keeps `d` of the point `(α, λ)`, computed by the caller, for [`Self::gaps`].
     fn prime_gaps(&self, alpha: f64, lam: &[f64], d: Vec<f64>) -> Arc<Vec<f64>> {
-        const KEEP: usize = 4;
         let d = Arc::new(d);
-        let mut cache = self.gaps_cache.borrow_mut();
-        if cache.len() == KEEP {
-            cache.remove(0);
-        }
-        cache.push((alpha, lam.to_vec(), d.clone()));
+        self.gaps_cache.put(alpha, lam, d.clone());
         d
     }
 
