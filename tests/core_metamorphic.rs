@@ -239,26 +239,34 @@ fn normal_and_tangential_rows_scaled_apart() {
     check_row_scalings(true);
 }
 
+/// The finite-element cases of the row-scaling tests: 4–6 × 2 elements, F = 0.3, 1, 5.
+fn scaled_fe_case(s: u64) -> common::Case {
+    common::fe_case(
+        s,
+        4 + (s % 3) as usize,
+        2,
+        [0.3, 1.0, 5.0][(s % 3) as usize],
+    )
+}
+
+/// p row factors spread log-uniformly over 1e-6 … 1e6.
+fn row_factors(rng: &mut Rng, p: usize) -> Vec<f64> {
+    (0..p).map(|_| 10f64.powf(rng.range(-6.0, 6.0))).collect()
+}
+
 fn check_row_scalings(apart: bool) {
     let mut cases: Vec<common::Case> = (0..60).map(random_case).collect();
     if apart {
         cases.extend((0..60).map(common::large_friction_case));
     }
-    cases.extend((0..12).map(|s| {
-        common::fe_case(
-            s,
-            4 + (s % 3) as usize,
-            2,
-            [0.3, 1.0, 5.0][(s % 3) as usize],
-        )
-    }));
+    cases.extend((0..12).map(scaled_fe_case));
     for (k, case) in cases.iter().enumerate() {
         let data = &case.data;
         let p = data.p;
         let mut rng = Rng::new(k as u64 + 4242);
-        let c: Vec<f64> = (0..p).map(|_| 10f64.powf(rng.range(-6.0, 6.0))).collect();
+        let c = row_factors(&mut rng, p);
         let d: Vec<f64> = if apart {
-            (0..p).map(|_| 10f64.powf(rng.range(-6.0, 6.0))).collect()
+            row_factors(&mut rng, p)
         } else {
             c.clone()
         };
@@ -328,21 +336,12 @@ fn per_row_scalings_under_an_oscillating_load() {
         let case = match k % 3 {
             0 => random_case(s),
             1 => common::large_friction_case(s),
-            _ => common::fe_case(
-                s,
-                4 + (s % 3) as usize,
-                2,
-                [0.3, 1.0, 5.0][(s % 3) as usize],
-            ),
+            _ => scaled_fe_case(s),
         };
         let data = &case.data;
         let mut rng = Rng::new(k + 777);
-        let c: Vec<f64> = (0..data.p)
-            .map(|_| 10f64.powf(rng.range(-6.0, 6.0)))
-            .collect();
-        let d: Vec<f64> = (0..data.p)
-            .map(|_| 10f64.powf(rng.range(-6.0, 6.0)))
-            .collect();
+        let c = row_factors(&mut rng, data.p);
+        let d = row_factors(&mut rng, data.p);
         let base = sine(data, case.a0, case.a1);
         let path = sine(&rows_scaled(data, &c, &d), case.a0, case.a1);
         let ctx = format!("case {k} (seed {s})");
