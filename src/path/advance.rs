@@ -1108,7 +1108,7 @@ impl Path {
                     let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
                     let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
                     let step = -v / form.eval(&t, &rate);
-                    if step.is_finite() && (pt.alpha + step).clamp(lo_a, hi_a) == pt.alpha + step {
+                    if step.is_finite() && (lo_a..=hi_a).contains(&(pt.alpha + step)) {
                         pt = self.step_along(pt.alpha, (&pt.lam, &d), (&t, &rate), step)?;
                     }
                 }
