@@ -61,6 +61,7 @@ __all__ = [
     "Event",
     "Piece",
     "Solution",
+    "Branch",
     "read_case",
     "Error",
     "NotPositiveDefinite",
@@ -181,13 +182,27 @@ class Solution:
     continuum: bool
 
 
+@dataclass(frozen=True)
+class Branch:
+    """A piece that continues the path at a bifurcation (or leaves its start point):
+    ``classes`` (the class of every node on it), ``direction`` (sign of d alpha / ds
+    along it, 0 for a vertical piece) and ``orientation_preserving`` (it keeps the path's
+    orientation, SPEC section 4: past a bifurcation the path takes the one branch that
+    does, and stops with ``end_reason == "bifurcation"`` when none or several do)."""
+
+    classes: Tuple[str, ...]
+    direction: int
+    orientation_preserving: bool
+
+
 class Path:
     """A traced path. Returned by :meth:`Problem.trace`; not created directly.
 
     ``events``, ``pieces`` and ``end_reason`` describe what was traced; ``event_state(k)``
     gives the full state at event k (one back-solve for u), ``solutions_at(alpha)`` every
     traced solution at alpha, ``to_dict()`` the JSON report of the CLI (1-based numbers),
-    ``resume()`` continues a path that its monitor stopped.
+    ``resume()`` continues a path that its monitor stopped, ``branches`` and
+    ``choose_branch(k)`` continue a path along another branch of a bifurcation.
     """
 
     def __init__(self, core: Any):
@@ -221,6 +236,17 @@ class Path:
         self.end_reason: str = reason if reason is not None else "none"
         #: The failure message when ``end_reason == "failed"``.
         self.end_message: Optional[str] = message
+        #: The candidate continuations (:class:`Branch`) at the last transition point,
+        #: 0-based as ``choose_branch`` takes them: empty unless it was a bifurcation
+        #: and the path has not moved on since (it ended there, ``end_reason ==
+        #: "bifurcation"``, or a monitor stopped it there).
+        self.branches: list = [Branch(tuple(c), d, o) for c, d, o in core.branches()]
+        #: The pieces that left the start point toward ``window[1]`` when more than one
+        #: did (a bifurcation at the start: the path took the first, or the one given
+        #: as ``branch=`` to :meth:`Problem.trace`); empty otherwise.
+        self.start_branches: list = [
+            Branch(tuple(c), d, o) for c, d, o in core.start_branches()
+        ]
 
     @property
     def start(self) -> Optional[dict]:
@@ -246,6 +272,27 @@ class Path:
         :class:`UsageError` when called from inside the path's own monitor.
         """
         self._core.resume(monitor)
+        self._refresh()
+        _raise_pending(self)
+        return self
+
+    def choose_branch(
+        self, k: int, monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None
+    ) -> "Path":
+        """Continues along ``branches[k]`` (0-based) instead of the branch the path took, or
+        after it stopped with ``end_reason == "bifurcation"``, and runs it on until it ends
+        again (as :meth:`resume`); returns the path. Only directly after the bifurcation:
+        when the path ended there, or a ``monitor`` stopped it at that transition point
+        (``branches`` is not empty). The events from the bifurcation on are replaced by
+        those of the chosen branch.
+
+        Raises: :class:`UsageError` when no bifurcation is pending (``branches`` is empty)
+        or ``k`` is out of range, with this path as ``err.path``; otherwise as
+        :meth:`resume`.
+        """
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 0:
+            raise ValueError(f"k = {k!r}: expected a branch index, an integer >= 0")
+        self._core.choose_branch(int(k), monitor)
         self._refresh()
         _raise_pending(self)
         return self
@@ -383,6 +430,8 @@ class Problem:
         n: Optional[int] = None,
         monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None,
         max_alpha_step: Optional[float] = None,
+        guess=None,
+        branch: Optional[int] = None,
     ) -> Path:
         """Traces the solution path over ``window = (alpha_start, alpha_end)``.
 
@@ -393,6 +442,16 @@ class Problem:
         ``alpha_start`` (default ``window[0]``) is where the fixed-alpha solve starts the
         path; it then goes toward ``window[1]``, through folds, until alpha leaves the
         window. ``max_steps`` bounds the number of transition points (default 10 000).
+
+        ``guess`` (None or 2p values: lambda_n of the p nodes, then lambda_t; force units,
+        lambda_n <= 0 compressive) is where the fixed-alpha solve starts instead of zero
+        forces. The contact problem at one alpha can have several solutions (large
+        friction, a path that folds back over ``alpha_start``); the solve returns one of
+        them, and which one can depend on rounding. A guess that solves the problem (to
+        1e-12 relative) is kept as it is: pass a known solution (``path.start``'s forces,
+        an event's, a :meth:`Path.solutions_at` state's) to trace from it. When several
+        pieces leave the start point toward ``window[1]`` (``path.start_branches``), the
+        path takes the first, or ``branch`` (0-based) when given.
 
         ``monitor(alpha, transitions, (first_event, end_event))`` is called after each
         transition point with its alpha, the number of transition points so far and the
@@ -409,7 +468,10 @@ class Problem:
         The GIL is released while tracing (re-acquired only to call ``load``, ``dload`` or
         ``monitor``), so threads can trace different problems at once.
 
-        Raises: ValueError for bad arguments; SolveError when the start solve fails; an
+        Raises: ValueError for bad arguments (``guess`` not 2p finite values, ``branch``
+        negative); UsageError when ``branch`` > 0 is not an index of
+        ``start_branches`` (with the path, started on its first branch, as ``err.path``);
+        SolveError when the start solve fails; an
         exception raised inside ``load``/``dload``/``monitor`` stops the path and is
         re-raised with what was traced kept on it as ``err.path`` (a :class:`Path`; after
         an exception of ``monitor`` it is stopped, ``end_reason == "stopped"``, and can be
@@ -421,6 +483,12 @@ class Problem:
         a0 = None if alpha_start is None else float(alpha_start)
         ms = None if max_steps is None else int(max_steps)
         h = None if max_alpha_step is None else float(max_alpha_step)
+        g = None if guess is None else _vector("guess", guess)
+        if branch is not None and (
+            isinstance(branch, bool) or not isinstance(branch, (int, np.integer)) or branch < 0
+        ):
+            raise ValueError(f"branch = {branch!r}: expected None or an integer >= 0")
+        b = None if branch is None else int(branch)
         if load is not None:
             if f0 is not None or f1 is not None:
                 raise ValueError("give either f0 and f1 (affine load) or load=, not both")
@@ -438,13 +506,15 @@ class Problem:
                 ms,
                 h,
                 monitor,
+                g,
+                b,
             )
         else:
             if f0 is None or f1 is None:
                 raise ValueError("an affine load needs f0 and f1 (or give load=)")
             try:
                 core = self._core.trace_affine(
-                    _vector("f0", f0), _vector("f1", f1), win, a0, ms, h, monitor
+                    _vector("f0", f0), _vector("f1", f1), win, a0, ms, h, monitor, g, b
                 )
             except Exception as err:  # noqa: BLE001
                 raise _reraise(err) from None

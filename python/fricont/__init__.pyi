@@ -51,15 +51,25 @@ class Solution:
     residual: float
     continuum: bool
 
+class Branch:
+    classes: Tuple[str, ...]
+    direction: int
+    orientation_preserving: bool
+
 class Path:
     events: list[Event]
     pieces: list[Piece]
     end_reason: str
     end_message: Optional[str]
+    branches: list[Branch]
+    start_branches: list[Branch]
     @property
     def start(self) -> Optional[dict[str, Any]]: ...
     def resume(
         self, monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None
+    ) -> Path: ...
+    def choose_branch(
+        self, k: int, monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None
     ) -> Path: ...
     def event_state(self, k: int) -> dict[str, Any]: ...
     def solutions_at(self, alpha: float) -> list[Solution]: ...
@@ -100,6 +110,8 @@ class Problem:
         n: Optional[int] = None,
         monitor: Optional[Callable[[float, int, Tuple[int, int]], Any]] = None,
         max_alpha_step: Optional[float] = None,
+        guess: Optional[npt.ArrayLike] = None,
+        branch: Optional[int] = None,
     ) -> Path: ...
 
 def read_case(directory: Any) -> dict[str, Any]: ...

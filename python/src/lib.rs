@@ -105,6 +105,19 @@ fn classes_list(c: &[Class]) -> Vec<&'static str> {
     c.iter().map(|&c| class_name(c)).collect()
 }
 
+/// Branches as (classes, direction, orientation_preserving) tuples.
+fn branch_tuples(b: &[fricont::path::Branch]) -> Vec<(Vec<&'static str>, i8, bool)> {
+    b.iter()
+        .map(|b| {
+            (
+                classes_list(&b.classes),
+                b.direction,
+                b.orientation_preserving,
+            )
+        })
+        .collect()
+}
+
 fn state_dict<'py>(py: Python<'py>, s: &State, with_u: bool) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("alpha", s.alpha)?;
@@ -224,7 +237,7 @@ impl Problem {
 
     /// Traces an affine load f0 + α f1 (see `fricont.Problem.trace`).
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (f0, f1, window, alpha_start, max_steps, max_alpha_step, monitor))]
+    #[pyo3(signature = (f0, f1, window, alpha_start, max_steps, max_alpha_step, monitor, guess, branch))]
     fn trace_affine(
         &self,
         py: Python<'_>,
@@ -235,17 +248,22 @@ impl Problem {
         max_steps: Option<usize>,
         max_alpha_step: Option<f64>,
         monitor: Option<Py<PyAny>>,
+        guess: Option<PyReadonlyArray1<'_, f64>>,
+        branch: Option<usize>,
     ) -> PyResult<Path> {
         let load = Load::affine(f0.as_slice()?.to_vec(), f1.as_slice()?.to_vec()).map_err(to_py)?;
         let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
-        self.trace(py, load, opts, monitor, None)
+        let guess = guess
+            .map(|g| g.as_slice().map(<[f64]>::to_vec))
+            .transpose()?;
+        self.trace(py, load, opts, monitor, None, guess, branch)
     }
 
     /// Traces a general load: `load(alpha)` returns f (n values); `dload(alpha)` its
     /// derivative (central differences when None). An exception inside either stops the
     /// path; it is kept on the path and re-raised by the Python layer.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (load, dload, n, window, alpha_start, max_steps, max_alpha_step, monitor))]
+    #[pyo3(signature = (load, dload, n, window, alpha_start, max_steps, max_alpha_step, monitor, guess, branch))]
     fn trace_general(
         &self,
         py: Python<'_>,
@@ -257,8 +275,13 @@ impl Problem {
         max_steps: Option<usize>,
         max_alpha_step: Option<f64>,
         monitor: Option<Py<PyAny>>,
+        guess: Option<PyReadonlyArray1<'_, f64>>,
+        branch: Option<usize>,
     ) -> PyResult<Path> {
         let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
+        let guess = guess
+            .map(|g| g.as_slice().map(<[f64]>::to_vec))
+            .transpose()?;
         let slot: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
         let wrap = |callable: Py<PyAny>, what: &'static str| {
             let slot = slot.clone();
@@ -297,7 +320,7 @@ impl Problem {
         let f = wrap(load, "load");
         let df = dload.map(|d| wrap(d, "dload"));
         let load = Load::general(n, f, df);
-        self.trace(py, load, opts, monitor, Some(slot))
+        self.trace(py, load, opts, monitor, Some(slot), guess, branch)
     }
 }
 
@@ -324,7 +347,9 @@ fn options(
 }
 
 impl Problem {
-    /// Makes the path, starts it at `opts.alpha_start` and runs it (see [`Path::advance`]).
+    /// Makes the path, starts it at `opts.alpha_start` (from `guess`, on start branch
+    /// `branch`) and runs it (see [`Path::advance`]).
+    #[allow(clippy::too_many_arguments)]
     fn trace(
         &self,
         py: Python<'_>,
@@ -332,8 +357,14 @@ impl Problem {
         opts: PathOptions,
         monitor: Option<Py<PyAny>>,
         load_error: Option<Arc<Mutex<Option<PyErr>>>>,
+        guess: Option<Vec<f64>>,
+        branch: Option<usize>,
     ) -> PyResult<Path> {
-        let start = opts.alpha_start;
+        let start = Begin::Start {
+            alpha: opts.alpha_start,
+            guess,
+            branch,
+        };
         let problem = self.inner.clone();
         let t0 = std::time::Instant::now();
         let path = fricont::Path::new(problem, load, opts).map_err(to_py)?;
@@ -347,8 +378,9 @@ impl Problem {
                 trace_s: 0.0,
             }),
             tracer: Mutex::new(None),
+            start_branches: Mutex::new(Vec::new()),
         };
-        path.advance(py, Some(start), monitor)?;
+        path.advance(py, start, monitor)?;
         Ok(path)
     }
 }
@@ -366,6 +398,24 @@ struct Path {
     /// The thread running the path while it holds `inner` (a call from its own monitor is
     /// refused instead of waiting for itself).
     tracer: Mutex<Option<ThreadId>>,
+    /// The pieces that left the start point toward alpha_end when more than one did
+    /// (`fricont::Path::branches` directly after the start), else empty.
+    start_branches: Mutex<Vec<fricont::path::Branch>>,
+}
+
+/// How [`Path::advance`] begins before it runs the path on.
+enum Begin {
+    /// Start at `alpha` (from `guess`, 2p forces, when given), then take start branch
+    /// `branch` when given.
+    Start {
+        alpha: f64,
+        guess: Option<Vec<f64>>,
+        branch: Option<usize>,
+    },
+    /// Continue along candidate `k` of the last bifurcation (`fricont::Path::choose_branch`).
+    Branch(usize),
+    /// Run on from where the path stopped.
+    Resume,
 }
 
 fn poisoned<T>(_: T) -> PyErr {
@@ -408,19 +458,15 @@ impl Path {
         }
     }
 
-    /// Starts the path at `start` (if given) and runs it until it ends, with the GIL
+    /// Begins as `begin` says (a start, a branch choice, or nothing) and runs the path
+    /// until it ends, with the GIL
     /// released; the GIL is taken again only to call a Python load or the monitor. The
     /// monitor is called as `monitor(alpha, transitions, (first_event, end_event))` after
     /// each transition point: a true result, or an exception, stops the path
     /// (`EndReason::Stopped`; a later run continues from there). The exception that ended
     /// the run is kept for `take_error`. Errors: UsageError when called from the path's
     /// own monitor.
-    fn advance(
-        &self,
-        py: Python<'_>,
-        start: Option<f64>,
-        monitor: Option<Py<PyAny>>,
-    ) -> PyResult<()> {
+    fn advance(&self, py: Python<'_>, begin: Begin, monitor: Option<Py<PyAny>>) -> PyResult<()> {
         if self.traced_here() {
             return Err(Self::busy());
         }
@@ -430,8 +476,23 @@ impl Path {
             let mut path = self.inner.lock().map_err(poisoned)?;
             *self.tracer.lock().map_err(poisoned)? = Some(std::thread::current().id());
             let mut run = || -> PyResult<()> {
-                if let Some(a) = start {
-                    path.start(a, None).map_err(to_py)?;
+                match &begin {
+                    Begin::Start {
+                        alpha,
+                        guess,
+                        branch,
+                    } => {
+                        path.start(*alpha, guess.as_deref()).map_err(to_py)?;
+                        *self.start_branches.lock().map_err(poisoned)? = path.branches().to_vec();
+                        // (branch 0 is the piece the start took, also when it is the only one)
+                        if let Some(k) = *branch
+                            && (k > 0 || !path.branches().is_empty())
+                        {
+                            path.choose_branch(k).map_err(to_py)?;
+                        }
+                    }
+                    Begin::Branch(k) => path.choose_branch(*k).map_err(to_py)?,
+                    Begin::Resume => {}
                 }
                 path.run_monitored(|_, pr| {
                     let Some(m) = &monitor else {
@@ -491,7 +552,30 @@ impl Path {
     /// for `take_error`. Errors: UsageError when called from the path's own monitor.
     #[pyo3(signature = (monitor))]
     fn resume(&self, py: Python<'_>, monitor: Option<Py<PyAny>>) -> PyResult<()> {
-        self.advance(py, None, monitor)
+        self.advance(py, Begin::Resume, monitor)
+    }
+
+    /// Continues along candidate `k` of the last bifurcation and runs the path on (see
+    /// `fricont.Path.choose_branch`). The exception that ends the run (UsageError when no
+    /// bifurcation is pending or `k` is out of range) is kept for `take_error`.
+    #[pyo3(signature = (k, monitor))]
+    fn choose_branch(&self, py: Python<'_>, k: usize, monitor: Option<Py<PyAny>>) -> PyResult<()> {
+        self.advance(py, Begin::Branch(k), monitor)
+    }
+
+    /// Candidate continuations at the last transition point, as (classes, direction,
+    /// orientation_preserving) tuples: empty unless it was a bifurcation and the path has
+    /// not moved since (see `fricont::Path::branches`).
+    fn branches(&self, py: Python<'_>) -> PyResult<Vec<(Vec<&'static str>, i8, bool)>> {
+        Ok(branch_tuples(self.lock(py)?.branches()))
+    }
+
+    /// The pieces that left the start point toward alpha_end when more than one did, as
+    /// `branches` (empty otherwise).
+    fn start_branches(&self) -> PyResult<Vec<(Vec<&'static str>, i8, bool)>> {
+        Ok(branch_tuples(
+            &self.start_branches.lock().map_err(poisoned)?,
+        ))
     }
 
     /// Events as tuples (alpha, node, from, to, fold, bifurcation, lambda_n, lambda_t,

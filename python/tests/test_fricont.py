@@ -17,6 +17,8 @@ import fricont
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SAMPLE = ROOT / "tests" / "data" / "sample-rect30"
+VERTEX_START = ROOT / "tests" / "data" / "vertex-start"
+BIFURCATION = ROOT / "tests" / "data" / "bifurcation-stop"
 CLI = pathlib.Path(os.environ.get("FRICONT_CLI", ROOT / "target" / "release" / "fricont"))
 EXAMPLES = ROOT / "python" / "examples"
 
@@ -349,3 +351,180 @@ def test_complex_input_is_refused_unless_it_is_real():
             (e.node, e.from_class, e.to_class) for e in ref.events
         ]
         assert abs(path.events[0].alpha - 0.5) <= 1e-14
+
+
+CLASSES = ("open", "stick", "slip+", "slip-")
+
+
+def brute_pieces(case):
+    """Every piece of a small problem (all 4^p class vectors), independently of fricont
+    (dense numpy, SPEC section 3): W = B A^-1 B^T, q = B A^-1 f, d = q + W lambda - (g, 0);
+    open: lambda = 0, guard -d_n > 0; stick: d = 0, guards -lambda_n > 0 and
+    |lambda_t| < -F lambda_n; slip s: d_n = 0, lambda_t = s F lambda_n, guards
+    -lambda_n > 0 and s d_t > 0. Returns (classes, l0, l1, lo, hi): lambda = l0 + alpha l1
+    on the open interval (lo, hi), for the nonempty ones."""
+    A = case["A"].toarray()
+    B = np.vstack([case["N"].toarray(), case["T"].toarray()])
+    p = B.shape[0] // 2
+    W = B @ np.linalg.solve(A, B.T)
+    W = (W + W.T) / 2
+    q0, q1 = B @ np.linalg.solve(A, case["f0"]), B @ np.linalg.solve(A, case["f1"])
+    gap = np.zeros(p) if case["gap"] is None else np.asarray(case["gap"])
+    F = np.broadcast_to(np.asarray(case["friction"], dtype=float), (p,))
+    out = []
+    for code in range(4**p):
+        cl = tuple(CLASSES[(code >> (2 * i)) & 3] for i in range(p))
+        M, r0, r1 = np.zeros((2 * p, 2 * p)), np.zeros(2 * p), np.zeros(2 * p)
+        for i, c in enumerate(cl):
+            if c == "open":
+                M[i, i] = M[p + i, p + i] = 1.0
+                continue
+            M[i], r0[i], r1[i] = W[i], gap[i] - q0[i], -q1[i]
+            if c == "stick":
+                M[p + i], r0[p + i], r1[p + i] = W[p + i], -q0[p + i], -q1[p + i]
+            else:
+                M[p + i, p + i], M[p + i, i] = 1.0, -(1.0 if c == "slip+" else -1.0) * F[i]
+        if np.linalg.cond(M) > 1e11:
+            continue
+        l0, l1 = np.linalg.solve(M, r0), np.linalg.solve(M, r1)
+        d0, d1 = q0 + W @ l0 - np.concatenate([gap, np.zeros(p)]), q1 + W @ l1
+        guards = []
+        for i, c in enumerate(cl):
+            n, t = i, p + i
+            if c == "open":
+                guards.append((-d0[n], -d1[n]))
+            elif c == "stick":
+                guards += [(-l0[n], -l1[n]), (l0[t] - F[i] * l0[n], l1[t] - F[i] * l1[n]),
+                           (-F[i] * l0[n] - l0[t], -F[i] * l1[n] - l1[t])]
+            else:
+                s = 1.0 if c == "slip+" else -1.0
+                guards += [(-l0[n], -l1[n]), (s * d0[t], s * d1[t])]
+        lo, hi = -np.inf, np.inf
+        for g0, g1 in guards:
+            if g1 > 0:
+                lo = max(lo, -g0 / g1)
+            elif g1 < 0:
+                hi = min(hi, -g0 / g1)
+            elif g0 <= 0:
+                hi = -np.inf
+        if lo < hi:
+            out.append((cl, l0, l1, lo, hi))
+    return out
+
+
+def incident(pieces, alpha, lam, tol=1e-8):
+    """The pieces whose closure holds the point (alpha, lambda), as {classes: the end at
+    alpha, "lo" or "hi"}."""
+    out = {}
+    for cl, l0, l1, lo, hi in pieces:
+        for end, a in (("lo", lo), ("hi", hi)):
+            if abs(a - alpha) <= tol * max(1.0, abs(alpha)) and np.allclose(
+                    l0 + a * l1, lam, rtol=0, atol=tol * max(1.0, np.abs(lam).max())):
+                out[cl] = end
+    return out
+
+
+def test_choose_branch_follows_each_continuation_of_a_bifurcation_the_path_stopped_at():
+    case = fricont.read_case(BIFURCATION)
+    prob = fricont.Problem(case["A"], case["N"], case["T"], friction=case["friction"])
+    window = (case["alpha_start"], case["alpha_end"])
+
+    def traced():
+        return prob.trace(case["f0"], case["f1"], window=window)
+
+    path = traced()
+    assert path.end_reason == "bifurcation" and path.start_branches == []
+    last = path.pieces[-1]
+    alpha, lam = last.alpha_to, last.lambda_to
+    # The brute force's pieces through the point, less the one the path came by, are the
+    # continuations: the path offers exactly those.
+    pieces = brute_pieces(case)
+    through = incident(pieces, alpha, lam)
+    assert last.classes in through
+    want = {cl: end for cl, end in through.items() if cl != last.classes}
+    assert len(want) >= 2
+    assert {b.classes for b in path.branches} == set(want)
+    # alpha_end < alpha_start: a piece leaving the point at its "hi" end goes down in alpha.
+    for b in path.branches:
+        assert b.direction == (-1 if want[b.classes] == "hi" else 1)
+    kept = [(e.alpha, e.node, e.from_class, e.to_class) for e in path.events]
+    for k, b in enumerate(path.branches):
+        other = traced()
+        assert other.choose_branch(k) is other
+        assert [(e.alpha, e.node, e.from_class, e.to_class) for e in other.events[:len(kept)]] == kept
+        after = [pc.classes for pc in other.pieces]
+        assert after[len(path.pieces)] == b.classes
+        assert other.end_reason == "window" and other.branches == []
+        # The chosen piece's next transition (or the window's end) where the brute force's
+        # piece ends.
+        (cl, l0, l1, lo, hi), = [pc for pc in pieces if pc[0] == b.classes]
+        nxt = other.pieces[len(path.pieces)]
+        end = max(lo, min(window)) if b.direction < 0 else min(hi, max(window))
+        assert nxt.alpha_to == pytest.approx(end, rel=1e-10, abs=1e-10)
+        np.testing.assert_allclose(nxt.lambda_to, l0 + end * l1, rtol=0, atol=1e-10)
+    # Choosing again after the path moved on, or an index out of range, is a usage error
+    # that carries the path.
+    with pytest.raises(fricont.UsageError) as err:
+        other.choose_branch(0)
+    assert err.value.path is other
+    with pytest.raises(fricont.UsageError):
+        traced().choose_branch(len(want))
+    with pytest.raises(ValueError):
+        traced().choose_branch(-1)
+
+
+def test_branch_starts_on_each_piece_leaving_a_zero_force_vertex():
+    # tests/data/vertex-start: the brute force (tests/core_vertex_start.rs, c-tests/
+    # start_branches.c) finds three solution curves leaving the start point toward
+    # alpha_end: (open, slip+), (slip-, slip+), (stick, slip-). Here they are checked
+    # against this file's own enumeration as well.
+    case = fricont.read_case(VERTEX_START)
+    prob = fricont.Problem(case["A"], case["N"], case["T"], friction=case["friction"])
+    window = (case["alpha_start"], case["alpha_end"])
+    path = prob.trace(case["f0"], case["f1"], window=window)
+    offered = [b.classes for b in path.start_branches]
+    assert set(offered) == {("open", "slip+"), ("slip-", "slip+"), ("stick", "slip-")}
+    # (the vertex: lambda = 0 at alpha_start; each curve leaves it toward alpha_end < 0)
+    through = incident(brute_pieces(case), window[0], np.zeros(4))
+    assert {cl for cl, end in through.items() if end == "hi"} == set(offered)
+    assert all(b.direction == -1 for b in path.start_branches)
+    assert path.pieces[0].classes == offered[0]
+    for k, cl in enumerate(offered):
+        other = prob.trace(case["f0"], case["f1"], window=window, branch=k)
+        assert other.pieces[0].classes == cl and other.end_reason == "window"
+        assert [b.classes for b in other.start_branches] == offered
+    with pytest.raises(fricont.UsageError) as err:
+        prob.trace(case["f0"], case["f1"], window=window, branch=3)
+    assert err.value.path.pieces[0].classes == offered[0]
+    with pytest.raises(ValueError, match="branch"):
+        prob.trace(case["f0"], case["f1"], window=window, branch=-1)
+
+
+def test_a_guess_that_solves_the_problem_starts_the_path_there():
+    # The hand-derived fold problem of tests/core_hand.rs (two_folds_three_solutions):
+    # A = diag(1, 1, 4), N = (1, 0, 0), T = (-1, 1, 0), F = 2, f = f0 + alpha f1. At
+    # alpha = -1 it has three solutions: open lambda = (0, 0), slip+ (-1, -2) (on
+    # (-2, 0)) and stick (-1.5, -2.5) (on (-2, 1.2), then slip- from alpha = 1.2 on).
+    A = sp.diags([1.0, 1.0, 4.0]).tocsr()
+    prob = fricont.Problem(A, [[1.0, 0.0, 0.0]], [[-1.0, 1.0, 0.0]], friction=2.0)
+    f0, f1 = [0.0, 1.0, 0.7], [1.0, -1.5, -0.3]
+    expect = {
+        # guess: (start class, events (alpha, from, to, fold), end alpha)
+        (0.0, 0.0): ("open", [(0.0, "open", "slip+", True)], -1.0),
+        (-1.0, -2.0): ("slip+", [(0.0, "slip+", "open", True)], -1.0),
+        (-1.5, -2.5): ("stick", [(1.2, "stick", "slip-", False)], 3.0),
+    }
+    for guess, (cls, events, end) in expect.items():
+        path = prob.trace(f0, f1, window=(-1.0, 3.0), guess=list(guess))
+        st = path.start
+        assert st["classes"] == [cls]
+        np.testing.assert_allclose([st["lambda_n"][0], st["lambda_t"][0]], guess, atol=1e-14)
+        got = [(e.alpha, e.from_class, e.to_class, e.fold) for e in path.events]
+        assert len(got) == len(events)
+        for (a, fc, tc, fold), (wa, wfc, wtc, wfold) in zip(got, events):
+            assert (fc, tc, fold) == (wfc, wtc, wfold) and a == pytest.approx(wa, abs=1e-13)
+        assert path.end_reason == "window"
+        assert path.pieces[-1].alpha_to == pytest.approx(end, abs=1e-13)
+    for bad, match in (([0.0], "2p"), ([0.0, float("nan")], "finite")):
+        with pytest.raises(ValueError, match=match):
+            prob.trace(f0, f1, window=(-1.0, 3.0), guess=bad)
