@@ -1313,6 +1313,12 @@ fricont_status fricont_path_set_monitor(struct fricont_path *path,
  * NULL, from zero forces. A restart clears the events and pieces traced so far. The load
  * callbacks may be called.
  *
+ * The problem at one α can have several solutions (large friction, a path that folds
+ * back over `alpha`); the solver returns one of them, and which one can depend on
+ * rounding. A `guess` that already solves the problem (to 1e-12 relative) is kept as it
+ * is: pass a known solution (an event's or a `fricont_path_solutions_at` state's forces)
+ * to trace from exactly that one.
+ *
  * * `alpha`: inside the window set by `fricont_path_set_window`.
  * * `guess`: NULL, or 2p values: λν of nodes 0..p−1 then λt of nodes 0..p−1; copied.
  * * `guess_len`: 2p when `guess` is not NULL (ignored otherwise).

@@ -1315,6 +1315,10 @@ impl Path {
 
     /// Starts (or restarts) the path at `alpha` with the fixed-α solver, from `guess`
     /// (`(λν, λt)`, 2p values) or from zero forces. Clears events and pieces.
+    /// The problem at one α can have several solutions (large friction, a path that folds
+    /// back over `alpha`); the solver returns one, and which one can depend on rounding. A
+    /// `guess` that already solves the problem (to 1e-12 relative) is kept as it is: pass a
+    /// known solution to trace from exactly that one.
     /// When several pieces leave the start point toward `alpha_end`, the path takes the
     /// first and [`Path::branches`] lists them all (see [`Path::choose_branch`]). When the
     /// start lies on a vertical piece (a continuum at this α), the path follows the way
