@@ -238,8 +238,8 @@ class Path:
         self.end_message: Optional[str] = message
         #: The candidate continuations (:class:`Branch`) at the last transition point,
         #: 0-based as ``choose_branch`` takes them: empty unless it was a bifurcation
-        #: and the path has not moved on since (it ended there, ``end_reason ==
-        #: "bifurcation"``, or a monitor stopped it there).
+        #: and the path has not moved on since (where it stopped there: ``end_reason ==
+        #: "bifurcation"``).
         self.branches: list = [Branch(tuple(c), d, o) for c, d, o in core.branches()]
         #: The pieces that left the start point toward ``window[1]`` when more than one
         #: did (a bifurcation at the start: the path took the first, or the one given
@@ -281,10 +281,9 @@ class Path:
     ) -> "Path":
         """Continues along ``branches[k]`` (0-based) instead of the branch the path took, or
         after it stopped with ``end_reason == "bifurcation"``, and runs it on until it ends
-        again (as :meth:`resume`); returns the path. Only directly after the bifurcation:
-        when the path ended there, or a ``monitor`` stopped it at that transition point
-        (``branches`` is not empty). The events from the bifurcation on are replaced by
-        those of the chosen branch.
+        again (as :meth:`resume`); returns the path. Only directly after the bifurcation
+        (``branches`` is not empty: the path stopped there). The chosen branch's events
+        follow those traced up to the bifurcation.
 
         Raises: :class:`UsageError` when no bifurcation is pending (``branches`` is empty)
         or ``k`` is out of range, with this path as ``err.path``; otherwise as
