@@ -145,6 +145,16 @@ struct TraceArgs {
     /// anyway.
     #[arg(long)]
     progress: bool,
+    /// Where several pieces leave the start point toward alpha_end (a bifurcation at the
+    /// start, listed in a note on stderr), trace piece K (1-based; default 1).
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u64).range(1..))]
+    start_branch: Option<u64>,
+    /// Where the path stops at a bifurcation (several pieces continue it and none is
+    /// singled out by the orientation; they are listed in a note on stderr), continue
+    /// along piece K (1-based). Repeat the option for the bifurcations met after it, in
+    /// order.
+    #[arg(long, value_name = "K", value_parser = clap::value_parser!(u64).range(1..))]
+    branch: Vec<u64>,
 }
 
 /// `--extended-precision`.
@@ -381,37 +391,68 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
     let t1 = Instant::now();
     path.start(alpha_start, None)
         .map_err(|e| runtime(format!("start at alpha = {alpha_start}: {e}")))?;
-    let branches = path.branches();
-    if let Some(first) = branches.first() {
-        // A bifurcation at the start: say which pieces leave it (by the nodes where they
-        // differ, 1-based) and which one is traced.
-        let differ: Vec<usize> = (0..first.classes.len())
-            .filter(|&i| branches.iter().any(|b| b.classes[i] != first.classes[i]))
-            .collect();
-        let list: Vec<String> = branches
-            .iter()
-            .enumerate()
-            .map(|(k, b)| {
-                let nodes: Vec<String> = differ
-                    .iter()
-                    .map(|&i| format!("node {} {}", i + 1, b.classes[i].name()))
-                    .collect();
-                format!("{}: {}", k + 1, nodes.join(", "))
-            })
-            .collect();
+    let offered = path.branches().len();
+    let start_branch = args.start_branch.unwrap_or(1);
+    if start_branch as usize > offered.max(1) {
+        return Err(input(format!(
+            "--start-branch {start_branch}: {} piece{} the start point toward alpha_end{}",
+            offered.max(1),
+            if offered > 1 { "s leave" } else { " leaves" },
+            if offered > 1 {
+                format!(" ({})", describe_branches(path.branches()))
+            } else {
+                String::new()
+            }
+        )));
+    }
+    if offered > 0 {
         eprintln!(
-            "fricont: note: {} pieces leave the start point toward alpha_end (a bifurcation); tracing the first [{}]",
-            branches.len(),
-            list.join("; ")
+            "fricont: note: {offered} pieces leave the start point toward alpha_end (a bifurcation): {}; tracing piece {start_branch}{}",
+            describe_branches(path.branches()),
+            if args.start_branch.is_none() {
+                " (--start-branch K takes another)"
+            } else {
+                ""
+            }
         );
+    }
+    if start_branch > 1 {
+        path.choose_branch(start_branch as usize - 1)
+            .map_err(|e| runtime(format!("--start-branch {start_branch}: {e}")))?;
     }
     progress.phase(&format!(
         "tracing from alpha = {alpha_start} toward {alpha_end}"
     ));
     let window = (alpha_start, alpha_end);
     let mut last = (alpha_start, 0usize);
+    let mut choices = args.branch.iter();
     let run = loop {
         match path.step() {
+            Ok(StepOutcome::End(fricont::EndReason::Bifurcation)) => {
+                let branches = path.branches();
+                let at =
+                    report::fmt_alpha(path.pieces().last().map_or(alpha_start, |p| p.alpha_to));
+                let listed = describe_branches(branches);
+                let Some(&k) = choices.next() else {
+                    eprintln!(
+                        "fricont: note: the path stops at a bifurcation at alpha = {at}: {} pieces continue it ({listed}); --branch K follows piece K",
+                        branches.len()
+                    );
+                    break Ok(fricont::EndReason::Bifurcation);
+                };
+                if k as usize > branches.len() {
+                    return Err(input(format!(
+                        "--branch {k}: {} pieces continue the path at the bifurcation at alpha = {at} ({listed})",
+                        branches.len()
+                    )));
+                }
+                eprintln!(
+                    "fricont: note: bifurcation at alpha = {at} ({listed}): following piece {k} (--branch)"
+                );
+                if let Err(e) = path.choose_branch(k as usize - 1) {
+                    break Err(e);
+                }
+            }
             Ok(StepOutcome::End(r)) => break Ok(r),
             Ok(StepOutcome::Transition { events, .. }) => {
                 if let Some(e) = path.events().get(events.end.wrapping_sub(1)) {
@@ -422,6 +463,13 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
             Err(e) => break Err(e),
         }
     };
+    let unused: Vec<String> = choices.map(|k| k.to_string()).collect();
+    if !unused.is_empty() {
+        eprintln!(
+            "fricont: note: --branch {} not used: the path did not stop at that many bifurcations",
+            unused.join(", ")
+        );
+    }
     let trace_s = t1.elapsed().as_secs_f64();
     let timing = Timing { setup_s, trace_s };
     if progress.enabled {
@@ -443,6 +491,34 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
         Ok(_) => Ok(()),
         Err(e) => Err(runtime(format!("path failed: {e}"))),
     }
+}
+
+/// Candidate pieces for a note: `K: node i class, …` (1-based), by the nodes where they
+/// differ, and the way each goes in α.
+fn describe_branches(branches: &[fricont::path::Branch]) -> String {
+    let Some(first) = branches.first() else {
+        return String::new();
+    };
+    let differ: Vec<usize> = (0..first.classes.len())
+        .filter(|&i| branches.iter().any(|b| b.classes[i] != first.classes[i]))
+        .collect();
+    branches
+        .iter()
+        .enumerate()
+        .map(|(k, b)| {
+            let nodes: Vec<String> = differ
+                .iter()
+                .map(|&i| format!("node {} {}", i + 1, b.classes[i].name()))
+                .collect();
+            let way = match b.direction {
+                1 => "alpha increasing",
+                -1 => "alpha decreasing",
+                _ => "vertical",
+            };
+            format!("{}: {} ({way})", k + 1, nodes.join(", "))
+        })
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 fn main() -> ExitCode {

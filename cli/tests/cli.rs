@@ -1256,3 +1256,142 @@ fn ill_conditioned_w_in_double_is_reported() {
         );
     }
 }
+
+fn data_dir(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data")
+        .join(name)
+}
+
+/// The class names of a JSON class array.
+fn names(v: &Value) -> Vec<String> {
+    v.as_array()
+        .expect("classes array")
+        .iter()
+        .map(|c| c.as_str().expect("class name").to_string())
+        .collect()
+}
+
+/// `--start-branch K` traces the K-th piece leaving the start point. On
+/// tests/data/vertex-start the brute force of tests/common finds three curves leaving
+/// alpha = 0 toward -1: (open, slip+), (slip-, slip+), (stick, slip-); the three values
+/// of K trace one each, in the order of the note. K beyond them, or above 1 where one piece
+/// leaves the start, is an input error (exit 2) naming what is there.
+#[test]
+fn start_branch_option_traces_each_piece_leaving_the_start() {
+    let dir = data_dir("vertex-start");
+    let mut first = Vec::new();
+    for k in ["1", "2", "3"] {
+        let (v, table) = trace_json(&dir, &["--start-branch", k]);
+        assert_eq!(v["end"]["reason"], "window", "K = {k}");
+        first.push(names(&v["pieces"][0]["classes"]));
+        assert!(
+            table.contains("end: alpha = -1.0000000000000, reason window"),
+            "{table}"
+        );
+    }
+    first.sort();
+    let want: Vec<Vec<String>> = [["open", "slip+"], ["slip-", "slip+"], ["stick", "slip-"]]
+        .iter()
+        .map(|c| c.iter().map(|s| s.to_string()).collect())
+        .collect();
+    assert_eq!(first, want);
+    let o = run(&["trace", dir.to_str().unwrap(), "--start-branch", "4"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--start-branch 4: 3 pieces leave the start point toward alpha_end"),
+        "{}",
+        stderr(&o)
+    );
+    let sample = sample_dir();
+    let o = run(&["trace", sample.to_str().unwrap(), "--start-branch", "2"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--start-branch 2: 1 piece leaves the start point"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(&["trace", sample.to_str().unwrap(), "--start-branch", "0"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}
+
+/// Where the path stops at a bifurcation, stderr lists the pieces that continue it and
+/// says how to follow one, and `--branch K` follows the K-th of `end.branches` (the
+/// library's candidates, checked against a brute-force enumeration by
+/// tests/core_symmetric.rs and, on this very case, python/tests): tests/data/bifurcation-
+/// stop, a mirror-symmetric pair, stops near alpha = -0.53 with three candidates. With
+/// `--branch K` the events up to the bifurcation are the same, the next piece is
+/// candidate K, its events there are flagged `bifurcation`, and the path reaches the
+/// window's end. An index beyond the candidates is an input error; a `--branch` left
+/// over is said.
+#[test]
+fn branch_option_continues_a_bifurcation_stop() {
+    let dir = data_dir("bifurcation-stop");
+    let out_dir = TempDir::new("bif");
+    let json_path = out_dir.path().join("stop.json");
+    let o = run(&[
+        "trace",
+        dir.to_str().unwrap(),
+        "--json",
+        json_path.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let stop: Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    check_schema(&stop);
+    assert_eq!(stop["end"]["reason"], "bifurcation");
+    let cands = stop["end"]["branches"].as_array().expect("end.branches");
+    assert_eq!(cands.len(), 3);
+    let at = fricont_exchange::report::fmt_alpha(num(&stop["end"]["alpha"], "end.alpha"));
+    assert!(
+        stderr(&o).contains(&format!(
+            "the path stops at a bifurcation at alpha = {at}: 3 pieces continue it"
+        )) && stderr(&o).contains("--branch K follows piece K"),
+        "{}",
+        stderr(&o)
+    );
+    let before = event_list(&stop);
+    let npieces = stop["pieces"].as_array().unwrap().len();
+    for (k, cand) in cands.iter().enumerate() {
+        let kk = (k + 1).to_string();
+        let (v, _) = trace_json(&dir, &["--branch", &kk]);
+        assert_eq!(v["end"]["reason"], "window", "K = {kk}");
+        let events = event_list(&v);
+        assert_eq!(&events[..before.len()], &before[..], "K = {kk}");
+        let next = &v["pieces"][npieces];
+        assert_eq!(names(&next["classes"]), names(&cand["classes"]), "K = {kk}");
+        assert_eq!(next["direction"], cand["direction"], "K = {kk}");
+        let at_bif: Vec<&Value> = v["events"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .skip(before.len())
+            .take_while(|e| e["alpha"] == stop["end"]["alpha"])
+            .collect();
+        assert!(
+            !at_bif.is_empty() && at_bif.iter().all(|e| e["bifurcation"] == true),
+            "K = {kk}: {at_bif:?}"
+        );
+    }
+    let o = run(&["trace", dir.to_str().unwrap(), "--branch", "4"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--branch 4: 3 pieces continue the path at the bifurcation"),
+        "{}",
+        stderr(&o)
+    );
+    let o = run(&[
+        "trace",
+        dir.to_str().unwrap(),
+        "--branch",
+        "1",
+        "--branch",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("following piece 1 (--branch)")
+            && stderr(&o).contains("--branch 2 not used"),
+        "{}",
+        stderr(&o)
+    );
+}
