@@ -16,7 +16,8 @@
  * thread) hands the request back to MATLAB:
  *
  *   [what, value] = fricont_mex('path_call', id, job, ...)  % 'start', 'run', 'step',
- *                                                           % 'solutions_at'
+ *                                                           % 'solutions_at',
+ *                                                           % 'choose_branch'
  *   while what is not 'done':   % the library waits for f(value) or f'(value) ('f',
  *                               % 'df') or for the monitor ('monitor', value = [alpha,
  *                               % transitions, first_event, last_event], from 1)
@@ -72,7 +73,7 @@ static void raise_error(const char *id, const char *fmt, ...) {
 /* ---- Worker thread (paths with a MATLAB-function load) ---------------------------- */
 
 enum { W_IDLE, W_JOB, W_RUNNING, W_WAIT_REPLY, W_REPLY_READY, W_DONE, W_QUIT };
-enum { JOB_START, JOB_RUN, JOB_STEP, JOB_SOLUTIONS_AT };
+enum { JOB_START, JOB_RUN, JOB_STEP, JOB_SOLUTIONS_AT, JOB_CHOOSE_BRANCH };
 enum { REQ_F, REQ_DF, REQ_MONITOR };
 
 typedef struct worker {
@@ -88,6 +89,7 @@ typedef struct worker {
     double job_alpha;
     double *job_guess;
     int64_t job_guess_len;
+    int64_t job_branch; /* JOB_CHOOSE_BRANCH: the candidate, 0-based */
     int32_t job_status;
     int64_t job_count;
     /* the pending request: f or f' at req_alpha into req_out, or the monitor */
@@ -155,6 +157,7 @@ static void *worker_main(void *arg) {
             break;
         case JOB_RUN: st = fricont_path_run(w->path); break;
         case JOB_STEP: st = fricont_path_step(w->path); break;
+        case JOB_CHOOSE_BRANCH: st = fricont_path_choose_branch(w->path, w->job_branch); break;
         default: st = fricont_path_solutions_at(w->path, w->job_alpha, &count); break;
         }
         pthread_mutex_lock(&w->mu);
@@ -479,11 +482,12 @@ static const char *end_reason_name(int32_t r) {
 
 /* 'path_call' for a path without worker: runs the job here and returns ('done', status). */
 static int32_t run_job_direct(entry *e, int job, double alpha, const double *guess,
-                              int64_t guess_len, int64_t *count) {
+                              int64_t guess_len, int64_t branch, int64_t *count) {
     switch (job) {
     case JOB_START: return fricont_path_start(e->path, alpha, guess, guess_len);
     case JOB_RUN: return fricont_path_run(e->path);
     case JOB_STEP: return fricont_path_step(e->path);
+    case JOB_CHOOSE_BRANCH: return fricont_path_choose_branch(e->path, branch);
     default: return fricont_path_solutions_at(e->path, alpha, count);
     }
 }
@@ -551,6 +555,7 @@ static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *pr
     double alpha = 0;
     const double *guess = NULL;
     int64_t guess_len = 0;
+    int64_t branch = 0;
     int monitored = 0;
     if (strcmp(job_name, "start") == 0) {
         NEED(4);
@@ -567,6 +572,15 @@ static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *pr
         monitored = nrhs > 3 && get_scalar(prhs[3], "monitored") != 0;
     } else if (strcmp(job_name, "step") == 0) {
         job = JOB_STEP;
+    } else if (strcmp(job_name, "choose_branch") == 0) {
+        /* ('path_call', id, 'choose_branch', k): candidate k, 1-based as MATLAB counts */
+        NEED(4);
+        job = JOB_CHOOSE_BRANCH;
+        double k = get_scalar(prhs[3], "branch");
+        if (!(k >= 1 && k <= 9.0e15 && k == (double)(int64_t)k))
+            mexErrMsgIdAndTxt("fricont:argument",
+                              "fricont: the branch must be a positive integer (1-based)");
+        branch = (int64_t)k - 1;
     } else if (strcmp(job_name, "solutions_at") == 0) {
         NEED(4);
         job = JOB_SOLUTIONS_AT;
@@ -585,7 +599,7 @@ static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *pr
               "monitor");
     if (!e->w) {
         int64_t count = 0;
-        int32_t st = run_job_direct(e, job, alpha, guess, guess_len, &count);
+        int32_t st = run_job_direct(e, job, alpha, guess, guess_len, branch, &count);
         job_outputs(nlhs, plhs, e, st, count, 0);
         return;
     }
@@ -604,6 +618,7 @@ static void cmd_path_call(int nlhs, mxArray *plhs[], int nrhs, const mxArray *pr
     }
     w->job = job;
     w->job_alpha = alpha;
+    w->job_branch = branch;
     w->state = W_JOB;
     pthread_cond_broadcast(&w->cv);
     pthread_mutex_unlock(&w->mu);
@@ -751,6 +766,25 @@ static void cmd_path_set(int nrhs, const mxArray *prhs[], const char *cmd) {
     }
 }
 
+/* The candidate branches at the path's last transition point (fricont_path_branch_count:
+ * none unless it was a bifurcation and the path has not moved since, or directly after a
+ * start that offered several) as a struct array: classes (cell of names), direction,
+ * orientation_preserving. `cls` holds p classes. */
+static mxArray *branch_array(fricont_path *path, int64_t p, int32_t *cls) {
+    int64_t count = 0;
+    check(fricont_path_branch_count(path, &count), "branches");
+    static const char *fields[] = {"classes", "direction", "orientation_preserving"};
+    mxArray *out = mxCreateStructMatrix((mwSize)count, 1, 3, fields);
+    for (int64_t k = 0; k < count; k++) {
+        fricont_branch br;
+        check(fricont_path_branch(path, k, &br, cls, p), "branch");
+        mxSetField(out, (mwIndex)k, "classes", class_cells(cls, p));
+        mxSetField(out, (mwIndex)k, "direction", mxCreateDoubleScalar(br.direction));
+        mxSetField(out, (mwIndex)k, "orientation_preserving", logical(br.orientation_preserving));
+    }
+    return out;
+}
+
 /* The traced path as a struct: events (with states), pieces, start, end. */
 static void cmd_path_result(mxArray *plhs[], int nrhs, const mxArray *prhs[], const char *cmd) {
     NEED(2);
@@ -808,8 +842,9 @@ static void cmd_path_result(mxArray *plhs[], int nrhs, const mxArray *prhs[], co
     check(fricont_path_end_reason(path, &reason), "end reason");
     check(fricont_path_callback_code(path, &code), "callback code");
     static const char *fields[] = {"events", "pieces", "start", "end_reason", "n", "p",
-                                   "callback_code"};
-    mxArray *out = mxCreateStructMatrix(1, 1, 7, fields);
+                                   "callback_code", "branches"};
+    mxArray *out = mxCreateStructMatrix(1, 1, 8, fields);
+    mxSetField(out, 0, "branches", branch_array(path, p, b.cls));
     mxSetField(out, 0, "events", events);
     mxSetField(out, 0, "pieces", pcs);
     mxSetField(out, 0, "start", start);
@@ -819,6 +854,15 @@ static void cmd_path_result(mxArray *plhs[], int nrhs, const mxArray *prhs[], co
     mxSetField(out, 0, "callback_code", mxCreateDoubleScalar((double)code));
     state_buf_free(&b);
     plhs[0] = out;
+}
+
+/* 'branches', id: the candidate branches now (see branch_array). */
+static void cmd_branches(mxArray *plhs[], int nrhs, const mxArray *prhs[], const char *cmd) {
+    NEED(2);
+    entry *e = idle_path(prhs[1]);
+    int32_t *cls = (int32_t *)mxMalloc(sizeof(int32_t) * (size_t)(e->p > 0 ? e->p : 1));
+    plhs[0] = branch_array(e->path, e->p, cls);
+    mxFree(cls);
 }
 
 /* Solutions 1..count of the last solutions_at as a struct array. */
@@ -888,6 +932,8 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[]) {
         cmd_resume(nlhs, plhs, nrhs, prhs, cmd);
     } else if (strcmp(cmd, "path_result") == 0) {
         cmd_path_result(plhs, nrhs, prhs, cmd);
+    } else if (strcmp(cmd, "branches") == 0) {
+        cmd_branches(plhs, nrhs, prhs, cmd);
     } else if (strcmp(cmd, "solutions") == 0) {
         cmd_solutions(plhs, nrhs, prhs, cmd);
     } else if (strcmp(cmd, "path_error_message") == 0) {

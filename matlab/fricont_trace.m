@@ -21,7 +21,12 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %          gap (p-vector, default 0), r (augmentation parameter, default 2p/trace(W)),
 %          storage ('full' default, 'lower' or 'upper': which triangle of A is stored),
 %          max_steps (default 10000), zero_tol (default 1e-11),
-%          guess (2p-vector [lambda_n; lambda_t] for the start solve),
+%          guess (2p-vector [lambda_n; lambda_t] for the start solve: the problem at
+%            one alpha can have several solutions (large friction, folds); the solve
+%            returns one of them, and a guess that solves the problem is kept, so a
+%            known solution is traced from exactly),
+%          start_branch (positive integer, default 1): where several pieces leave the
+%            start point toward alpha1 (res.start_branches), trace piece start_branch,
 %          max_alpha_step (alpha units, finite and > 0; default 1/8 of the window): the
 %            largest step of a load function's step control. A feature of the load
 %            narrower than the steps (a bump, a fast oscillation) can be stepped over
@@ -50,10 +55,15 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %     start   the start point (alpha, residual, u, lambda_n, lambda_t, classes).
 %     end_reason  'window', 'max_steps', 'closed_loop', 'bifurcation', 'failed' or
 %             'stopped' (by the monitor).
+%     branches  struct array (classes, direction, orientation_preserving): where the
+%             path stopped at a bifurcation (end_reason 'bifurcation'), the pieces that
+%             continue it; FRICONT_CHOOSE_BRANCH follows one. Empty otherwise.
+%     start_branches  the same for the pieces that left the start point toward
+%             alpha1, where more than one did (empty otherwise).
 %     n, p, r, window, and handle/load (used by fricont_solutions_at; the library path
 %     is freed when the last copy of the struct is cleared).
 %
-%   See also FRICONT_SOLUTIONS_AT, FRICONT_RESUME.
+%   See also FRICONT_SOLUTIONS_AT, FRICONT_RESUME, FRICONT_CHOOSE_BRANCH.
   if nargin < 7
     error('fricont:argument', 'fricont_trace: needs A, N, T, f0, f1, F and the window');
   end
@@ -64,7 +74,7 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
     error('fricont:argument', 'fricont_trace: opts must be a scalar struct');
   end
   valid = {'gap', 'r', 'storage', 'max_steps', 'zero_tol', 'guess', 'max_alpha_step', ...
-           'monitor'};
+           'monitor', 'start_branch'};
   unknown = setdiff(fieldnames(opts), valid);
   if ~isempty(unknown)
     error('fricont:argument', 'fricont_trace: unknown option ''%s''; the options are: %s', ...
@@ -78,6 +88,14 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
     monitor = opts.monitor;
     if ~isempty(monitor) && ~isa(monitor, 'function_handle')
       error('fricont:argument', 'fricont_trace: opts.monitor must be a function handle or []');
+    end
+  end
+  start_branch = 1;
+  if isfield(opts, 'start_branch')
+    start_branch = opts.start_branch;
+    if ~isnumeric(start_branch) || ~isreal(start_branch) || ~isscalar(start_branch) || ...
+        start_branch < 1 || start_branch ~= fix(start_branch)
+      error('fricont:argument', 'fricont_trace: opts.start_branch must be a positive integer');
     end
   end
   storage = 'full';
@@ -130,9 +148,18 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
     guess = full(double(opts.guess(:)));
   end
   fricont_drive(id, load, n, 'start', double(window(1)), guess);
+  start_branches = fricont_mex('branches', id);
+  if start_branch > max(numel(start_branches), 1)
+    error('fricont:argument', ['fricont_trace: opts.start_branch = %d, but %d piece(s) ' ...
+          'leave the start point toward alpha1'], start_branch, max(numel(start_branches), 1));
+  end
+  if start_branch > 1
+    fricont_drive(id, load, n, 'choose_branch', double(start_branch));
+  end
   fricont_drive(id, load, n, 'run', monitor);
 
   res = fricont_mex('path_result', id);
+  res.start_branches = start_branches;
   res.r = r;
   res.window = double(window(:).');
   res.handle = handle;

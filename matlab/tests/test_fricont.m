@@ -354,6 +354,81 @@ function failures = test_fricont(case_dir, out_dir)
                     strcmp(ident, 'fricont:argument') && ~isempty(strfind(msg, 'max_alpha_step')), msg);
   clear pb pd;
   failures = failures + check('every handle freed after the max_alpha_step cases', fricont_mex('count') == 0);
+
+  % 8. Bifurcations. tests/data/bifurcation-stop (a mirror-symmetric pair) stops at a
+  %    bifurcation with three candidates (python/tests checks them against a brute-force
+  %    enumeration): fricont_choose_branch(res, k) follows candidate k to the window's end,
+  %    keeping the events before it, with states that satisfy the equations (checked here).
+  data = fileparts(case_dir);
+  b = fricont_read_case(fullfile(data, 'bifurcation-stop'));
+  bwin = [b.alpha_start b.alpha_end];
+  stop = fricont_trace(b.A, b.N, b.T, b.f0, b.f1, b.F, bwin, struct('gap', b.gap));
+  failures = failures + check('bifurcation: the path stops with three candidates', ...
+                    strcmp(stop.end_reason, 'bifurcation') && numel(stop.branches) == 3 && ...
+                    isempty(stop.start_branches));
+  np = numel(stop.pieces);
+  ok = true;
+  why = '';
+  for k = 1:numel(stop.branches)
+    other = fricont_trace(b.A, b.N, b.T, b.f0, b.f1, b.F, bwin, struct('gap', b.gap));
+    other = fricont_choose_branch(other, k);
+    ne = numel(stop.events);
+    if ~strcmp(other.end_reason, 'window') || ~isempty(other.branches) || ...
+        ~same_events(other.events(1:ne), stop.events) || ...
+        ~isequal(other.pieces(np + 1).classes, stop.branches(k).classes) || ...
+        other.pieces(np + 1).direction ~= stop.branches(k).direction || ...
+        numel(other.events) <= ne || ~other.events(ne + 1).bifurcation
+      ok = false;
+      why = [why sprintf('branch %d: end %s, %d events; ', k, other.end_reason, numel(other.events))];
+    end
+    for e = other.events(ne + 1:end).'
+      [good, w] = check_solution(b, e, b.f0 + e.alpha * b.f1);
+      if ~good
+        ok = false;
+        why = [why sprintf('branch %d event %d: %s; ', k, e.index, w)];
+      end
+    end
+  end
+  failures = failures + check('fricont_choose_branch follows each candidate', ok, why);
+  %    The same through a load function (the worker thread runs the choice).
+  fh = fricont_trace(b.A, b.N, b.T, @(a) b.f0 + a * b.f1, @(a) b.f1, b.F, bwin, struct('gap', b.gap));
+  fh = fricont_choose_branch(fh, numel(stop.branches));
+  failures = failures + check('fricont_choose_branch through a load function: the affine events', ...
+                    strcmp(fh.end_reason, 'window') && ...
+                    isequal({fh.events.to}, {other.events.to}) && ...
+                    max(abs([fh.events.alpha] - [other.events.alpha])) <= 1e-9);
+  [ident, msg] = caught(@() fricont_choose_branch(stop, 4));
+  failures = failures + check('fricont_choose_branch k out of range: fricont:ERR_RANGE', ...
+                    strcmp(ident, 'fricont:ERR_RANGE'), [ident ' ' msg]);
+  [ident, msg] = caught(@() fricont_choose_branch(other, 1));
+  failures = failures + check('fricont_choose_branch after the path moved on: fricont:ERR_ORDER', ...
+                    strcmp(ident, 'fricont:ERR_ORDER'), [ident ' ' msg]);
+  [ident, msg] = caught(@() fricont_choose_branch(stop, 1.5));
+  failures = failures + check('fricont_choose_branch k not an integer: fricont:argument', ...
+                    strcmp(ident, 'fricont:argument'), [ident ' ' msg]);
+
+  %    tests/data/vertex-start: three curves leave the start point toward alpha_end (the
+  %    brute force of tests/common: (open, slip+), (slip-, slip+), (stick, slip-));
+  %    opts.start_branch = k traces the k-th of res.start_branches.
+  v = fricont_read_case(fullfile(data, 'vertex-start'));
+  vwin = [v.alpha_start v.alpha_end];
+  first = fricont_trace(v.A, v.N, v.T, v.f0, v.f1, v.F, vwin, struct('gap', v.gap));
+  sb = first.start_branches;
+  got = sort(cellfun(@(c) strjoin(c(:).', ','), {sb.classes}, 'UniformOutput', false));
+  failures = failures + check('start_branches: the three curves of the brute force', ...
+                    isequal(got, {'open,slip+', 'slip-,slip+', 'stick,slip-'}), strjoin(got, '; '));
+  ok = true;
+  for k = 1:numel(sb)
+    r = fricont_trace(v.A, v.N, v.T, v.f0, v.f1, v.F, vwin, struct('gap', v.gap, 'start_branch', k));
+    ok = ok && strcmp(r.end_reason, 'window') && isequal(r.pieces(1).classes, sb(k).classes);
+  end
+  failures = failures + check('opts.start_branch traces each piece leaving the start', ok);
+  [ident, msg] = caught(@() fricont_trace(v.A, v.N, v.T, v.f0, v.f1, v.F, vwin, ...
+                                          struct('gap', v.gap, 'start_branch', 4)));
+  failures = failures + check('opts.start_branch beyond them: fricont:argument', ...
+                    strcmp(ident, 'fricont:argument') && ~isempty(strfind(msg, '3 piece(s)')), msg);
+  clear stop other first r fh;
+  failures = failures + check('every handle freed after the bifurcation cases', fricont_mex('count') == 0);
   fprintf('matlab test_fricont: %d failed check(s)\n', failures);
 end
 
