@@ -80,6 +80,10 @@ module fricont
     integer, parameter, public :: FRICONT_END_BIFURCATION = 4
     integer, parameter, public :: FRICONT_END_FAILED = 5
     integer, parameter, public :: FRICONT_END_STOPPED = 6
+    ! ---- Extended precision modes (fricont_problem_set_extended_precision) ---------------
+    integer, parameter, public :: FRICONT_EXTENDED_AUTO = 0
+    integer, parameter, public :: FRICONT_EXTENDED_ON = 1
+    integer, parameter, public :: FRICONT_EXTENDED_OFF = 2
 
     public :: fricont_load_fn, fricont_weights_fn, fricont_solve_fn, fricont_monitor_fn
     public :: fricont_class_name, fricont_end_reason_name, fricont_status_name, fricont_version
@@ -124,6 +128,15 @@ module fricont
         integer(c_int32_t), allocatable :: classes(:)
     end type fricont_piece
 
+    !> A candidate continuation at a bifurcation (or a piece leaving the start point):
+    !> the classes of its nodes, the sign of d alpha / ds along it (0: vertical) and
+    !> whether it keeps the path's orientation.
+    type, public :: fricont_branch
+        integer :: direction = 0
+        logical :: orientation_preserving = .false.
+        integer(c_int32_t), allocatable :: classes(:)
+    end type fricont_branch
+
     !> A contact problem (owns a fricont_problem handle).
     type, public :: fricont_problem
         type(c_ptr), private :: h = c_null_ptr
@@ -137,6 +150,8 @@ module fricont
         procedure :: set_gap => problem_set_gap
         procedure :: set_r => problem_set_r
         procedure :: set_threads => problem_set_threads
+        procedure :: set_extended_precision => problem_set_extended_precision
+        procedure :: extended_precision => problem_extended_precision
         procedure :: build => problem_build
         procedure :: n => problem_n
         procedure :: p => problem_p
@@ -176,6 +191,9 @@ module fricont
         procedure :: piece => path_piece
         procedure :: solutions_at => path_solutions_at
         procedure :: solution => path_solution
+        procedure :: branch_count => path_branch_count
+        procedure :: branch => path_branch
+        procedure :: choose_branch => path_choose_branch
         procedure :: is_created => path_is_created
         procedure :: free => path_free
         procedure, private :: path_assign
@@ -215,6 +233,11 @@ module fricont
         real(c_double) :: alpha_from, alpha_to
         integer(c_int32_t) :: direction, orientation, det_sign
     end type c_piece
+
+    type, bind(C) :: c_branch
+        integer(c_int32_t) :: direction
+        logical(c_bool) :: orientation_preserving
+    end type c_branch
 
     type, bind(C) :: c_solution
         integer(c_int64_t) :: piece
@@ -495,6 +518,42 @@ module fricont
             integer(c_int32_t), intent(out) :: classes(*)
             integer(c_int64_t), value :: len
             integer(c_int32_t) :: c_path_piece
+        end function
+        function c_path_branch_count(h, c) bind(C, name="fricont_path_branch_count")
+            import :: c_ptr, c_int32_t, c_int64_t
+            type(c_ptr), value :: h
+            integer(c_int64_t), intent(out) :: c
+            integer(c_int32_t) :: c_path_branch_count
+        end function
+        function c_path_branch(h, k, b, classes, len) bind(C, name="fricont_path_branch")
+            import :: c_ptr, c_int32_t, c_int64_t, c_branch
+            type(c_ptr), value :: h
+            integer(c_int64_t), value :: k
+            type(c_branch), intent(out) :: b
+            integer(c_int32_t), intent(out) :: classes(*)
+            integer(c_int64_t), value :: len
+            integer(c_int32_t) :: c_path_branch
+        end function
+        function c_path_choose_branch(h, k) bind(C, name="fricont_path_choose_branch")
+            import :: c_ptr, c_int32_t, c_int64_t
+            type(c_ptr), value :: h
+            integer(c_int64_t), value :: k
+            integer(c_int32_t) :: c_path_choose_branch
+        end function
+        function c_problem_set_extended_precision(h, mode) &
+            bind(C, name="fricont_problem_set_extended_precision")
+            import :: c_ptr, c_int32_t
+            type(c_ptr), value :: h
+            integer(c_int32_t), value :: mode
+            integer(c_int32_t) :: c_problem_set_extended_precision
+        end function
+        function c_problem_extended_precision(h, extended, w_condition) &
+            bind(C, name="fricont_problem_extended_precision")
+            import :: c_ptr, c_int32_t, c_double
+            type(c_ptr), value :: h
+            integer(c_int32_t), intent(out) :: extended
+            real(c_double), intent(out) :: w_condition
+            integer(c_int32_t) :: c_problem_extended_precision
         end function
         function c_path_solutions_at(h, alpha, c) bind(C, name="fricont_path_solutions_at")
             import :: c_ptr, c_int32_t, c_int64_t, c_double
@@ -834,6 +893,38 @@ contains
         call handle(c_problem_set_threads(self%h, int(threads, c_int64_t)), err, &
                     'fricont_problem%set_threads')
     end subroutine problem_set_threads
+
+    !> Whether W and the condensed loads are carried beyond double precision:
+    !> FRICONT_EXTENDED_AUTO (the default: where the refinement is cheap, or W is
+    !> ill-conditioned and it is affordable), FRICONT_EXTENDED_ON or FRICONT_EXTENDED_OFF;
+    !> see fricont_problem_set_extended_precision in fricont.h. A change drops the
+    !> factorisation (the next build factorises again). FRICONT_ERR_RANGE for another
+    !> value (the setting is then unchanged).
+    subroutine problem_set_extended_precision(self, mode, err)
+        class(fricont_problem), intent(inout) :: self
+        integer, intent(in) :: mode
+        type(fricont_error), intent(out), optional :: err
+        call handle(c_problem_set_extended_precision(self%h, int(mode, c_int32_t)), err, &
+                    'fricont_problem%set_extended_precision')
+    end subroutine problem_set_extended_precision
+
+    !> True when the problem is traced in extended precision (builds it if needed, so it
+    !> returns the build's errors too); `w_condition` receives the estimate of the 2-norm
+    !> condition number of the equilibrated W (dimensionless, usually a lower bound
+    !> within a few percent).
+    logical function problem_extended_precision(self, w_condition, err)
+        class(fricont_problem), intent(inout) :: self
+        real(real64), intent(out), optional :: w_condition
+        type(fricont_error), intent(out), optional :: err
+        integer(c_int32_t) :: e
+        real(c_double) :: k
+        e = 0
+        k = 0
+        call handle(c_problem_extended_precision(self%h, e, k), err, &
+                    'fricont_problem%extended_precision')
+        problem_extended_precision = e /= 0
+        if (present(w_condition)) w_condition = k
+    end function problem_extended_precision
 
     !> Validates and factorises now (optional: paths build when needed).
     subroutine problem_build(self, err)
@@ -1304,6 +1395,50 @@ contains
         pc%orientation = cp%orientation
         pc%det_sign = cp%det_sign
     end function path_piece
+
+    !> Number of candidate continuations at the last transition point: 0 unless it was a
+    !> bifurcation and no step has been taken since (the path ended there with
+    !> FRICONT_END_BIFURCATION, or the step that found it returned FRICONT_BIFURCATION);
+    !> directly after `start`, the number of pieces leaving the start point toward the
+    !> window's end when more than one does.
+    integer(int64) function path_branch_count(self, err)
+        class(fricont_path), intent(in) :: self
+        type(fricont_error), intent(out), optional :: err
+        integer(c_int64_t) :: c
+        c = 0
+        call handle(c_path_branch_count(self%h, c), err, 'fricont_path%branch_count')
+        path_branch_count = c
+    end function path_branch_count
+
+    !> Candidate k (1-based, up to branch_count) at the last bifurcation (or start).
+    !> FRICONT_ERR_RANGE for k out of range, FRICONT_ERR_ORDER before the start.
+    type(fricont_branch) function path_branch(self, k, err) result(b)
+        class(fricont_path), intent(in) :: self
+        integer, intent(in) :: k
+        type(fricont_error), intent(out), optional :: err
+        type(c_branch) :: cb
+        integer(c_int32_t) :: st
+        allocate (b%classes(max(self%p, 1_int64)))
+        st = c_path_branch(self%h, int(k - 1, c_int64_t), cb, b%classes, self%p)
+        call handle(st, err, 'fricont_path%branch')
+        if (st /= FRICONT_OK) return
+        b%direction = cb%direction
+        b%orientation_preserving = logical(cb%orientation_preserving)
+    end function path_branch
+
+    !> Continues along candidate k (1-based) of the last bifurcation instead of the branch
+    !> the path took (or after it ended with FRICONT_END_BIFURCATION); directly after
+    !> `start`, starts again on the k-th piece leaving the start point. The next `step` or
+    !> `run` follows it. Only directly after the bifurcation (or start):
+    !> FRICONT_ERR_ORDER otherwise, FRICONT_ERR_RANGE for k out of range. May call the
+    !> load callback.
+    subroutine path_choose_branch(self, k, err)
+        class(fricont_path), intent(inout) :: self
+        integer, intent(in) :: k
+        type(fricont_error), intent(out), optional :: err
+        call handle(c_path_choose_branch(self%h, int(k - 1, c_int64_t)), err, &
+                    'fricont_path%choose_branch')
+    end subroutine path_choose_branch
 
     !> Computes every traced solution at alpha; `count` receives their number (several
     !> past a fold, 0 if the path never reached alpha). Read them with `solution`.

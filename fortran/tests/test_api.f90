@@ -2,7 +2,9 @@
 !> with the C interface): the err argument, 0- and 1-based CSR with 32- and 64-bit
 !> indices, a failing Fortran callback, the basis load, solutions_at checked against the
 !> equations evaluated here, the monitor (stop and resume, against the unmonitored run)
-!> and the largest alpha step (a narrow bump found at its analytic alpha).
+!> and the largest alpha step (a narrow bump found at its analytic alpha), bifurcations
+!> (branches followed to the end, their states checked against the equations here) and
+!> the extended-precision setting (W's condition estimate against a hand value).
 !> Prints "ok NAME" / "FAIL NAME: why"; exits 1 on a failure.
 module api_callbacks
     use, intrinsic :: iso_c_binding, only: c_double, c_int64_t, c_int32_t, c_ptr, &
@@ -117,6 +119,8 @@ program test_api
     call read_case(trim(dir), c)
     call run_all(c)
     call host_input()
+    ! (the cases beside the sample: DIR/../bifurcation-stop, DIR/../vertex-start)
+    call bifurcations(dir(1:index(trim(dir), '/', back=.true.)))
     write (*, '(a,i0,a)') 'fortran test_api: ', failures, ' failed check(s)'
     if (failures > 0) error stop 1
 
@@ -459,6 +463,154 @@ contains
         call path%current(s)
         call check('host solve: u at alpha = 1 is (0, 1/2)', allocated(s%u) .and. &
                    abs(s%u(1)) <= 1e-15_real64 .and. abs(s%u(2) - 0.5_real64) <= 1e-15_real64)
+        ! Extended precision of the condensed W = diag(1/2, 1): condition 2, not
+        ! ill-conditioned, so auto traces in double and on in double-double.
+        block
+            real(real64) :: kappa
+            logical :: ext
+            w(1, 2) = 0
+            call cp%create_condensed(w)
+            call cp%set_friction(0.5_real64)
+            ext = cp%extended_precision(kappa)
+            call check('W = diag(1/2, 1): condition estimate 2, auto traces in double', &
+                       .not. ext .and. abs(kappa - 2) <= 1e-9_real64)
+            call cp%set_extended_precision(FRICONT_EXTENDED_ON)
+            ext = cp%extended_precision(kappa)
+            call check('extended precision on: in double-double', ext)
+            call cp%set_extended_precision(3, err)
+            call check('extended precision mode 3: FRICONT_ERR_RANGE', &
+                       err%status == FRICONT_ERR_RANGE, err%message)
+        end block
     end subroutine host_input
+
+    !> True when `s` (at its alpha) satisfies A u = f + N' lambda_n + T' lambda_t and the
+    !> conditions of each node's class, to 1e-9 relative (evaluated here, from the case).
+    logical function state_holds(c, s) result(ok)
+        type(case_data), intent(in) :: c
+        type(fricont_state), intent(in) :: s
+        real(real64), allocatable :: f(:), r(:), dn(:), dt(:)
+        real(real64) :: tu, tf, fi, ln, lt
+        integer :: i
+        f = c%f0 + s%alpha*c%f1
+        r = matvec(c%a, s%u) - f - matvec_t(c%n, s%lambda_n) - matvec_t(c%t, s%lambda_t)
+        ok = maxval(abs(r)) <= 1e-9_real64*maxval(abs(f))
+        dn = matvec(c%n, s%u) - c%gap
+        dt = matvec(c%t, s%u)
+        tu = 1e-9_real64*maxval(abs(s%u))
+        tf = 1e-9_real64*max(maxval(abs(s%lambda_n)), maxval(abs(s%lambda_t)))
+        do i = 1, size(dn)
+            fi = c%friction(min(i, size(c%friction)))
+            ln = s%lambda_n(i)
+            lt = s%lambda_t(i)
+            ok = ok .and. ln <= tf .and. dn(i) <= tu .and. abs(lt) <= -fi*ln + tf
+            select case (s%classes(i))
+            case (FRICONT_OPEN)
+                ok = ok .and. abs(ln) <= tf .and. abs(lt) <= tf
+            case (FRICONT_STICK)
+                ok = ok .and. abs(dn(i)) <= tu .and. abs(dt(i)) <= tu
+            case (FRICONT_SLIP_PLUS)
+                ok = ok .and. abs(dn(i)) <= tu .and. abs(lt - fi*ln) <= tf .and. dt(i) >= -tu
+            case (FRICONT_SLIP_MINUS)
+                ok = ok .and. abs(dn(i)) <= tu .and. abs(lt + fi*ln) <= tf .and. dt(i) <= tu
+            end select
+        end do
+    end function state_holds
+
+    !> tests/data/bifurcation-stop, a mirror-symmetric pair, stops at a bifurcation with
+    !> three candidates (python/tests checks them against a brute-force enumeration):
+    !> choose_branch(k) follows each to the window's end, the events before it kept, the
+    !> states after it satisfying the equations. tests/data/vertex-start: three pieces
+    !> leave the start point, the curves the brute force of tests/common finds, (open,
+    !> slip+), (slip-, slip+), (stick, slip-); choose_branch(k) directly after the start
+    !> starts on the k-th.
+    subroutine bifurcations(data)
+        character(len=*), intent(in) :: data
+        type(case_data) :: b, v
+        type(fricont_problem) :: prob
+        type(fricont_path) :: path
+        type(fricont_branch) :: cand(3), extra
+        type(fricont_piece) :: pc
+        type(fricont_state) :: s
+        type(fricont_error) :: err
+        type(fricont_event), allocatable :: ev0(:), ev(:)
+        integer :: reason, k, j, np
+        integer(int64) :: nb
+        logical :: ok, found(3)
+        character(len=64) :: why
+
+        call read_case(data//'bifurcation-stop', b)
+        call make_problem(b, prob)
+        call path%create_affine(prob, b%f0, b%f1)
+        call path%set_window(b%alpha_start, b%alpha_end)
+        call path%start(b%alpha_start)
+        call path%run(reason)
+        nb = path%branch_count()
+        call check('bifurcation: the path stops with three candidates', &
+                   reason == FRICONT_END_BIFURCATION .and. nb == 3)
+        if (nb /= 3) return
+        ev0 = path%events()
+        np = int(path%piece_count())
+        do k = 1, 3
+            cand(k) = path%branch(k)
+        end do
+        extra = path%branch(4, err)
+        call check('branch 4 of 3: FRICONT_ERR_RANGE', err%status == FRICONT_ERR_RANGE, err%message)
+        ok = .true.
+        why = ''
+        do k = 1, 3
+            call path%start(b%alpha_start)
+            call path%run(reason)
+            call path%choose_branch(k)
+            call path%run(reason)
+            ev = path%events()
+            pc = path%piece(np + 1)
+            if (reason /= FRICONT_END_WINDOW .or. size(ev) <= size(ev0) .or. &
+                any(pc%classes /= cand(k)%classes) .or. pc%direction /= cand(k)%direction) then
+                ok = .false.
+                write (why, '(a,i0)') 'branch ', k
+                cycle
+            end if
+            ok = ok .and. all(ev(1:size(ev0))%alpha == ev0%alpha) .and. &
+                 all(ev(1:size(ev0))%node == ev0%node) .and. ev(size(ev0) + 1)%bifurcation
+            do j = size(ev0) + 1, size(ev)
+                call path%event_state(j, s)
+                if (.not. state_holds(b, s)) then
+                    ok = .false.
+                    write (why, '(a,i0,a,i0)') 'branch ', k, ' event ', j
+                end if
+            end do
+        end do
+        call check('choose_branch follows each candidate to the window''s end', ok, trim(why))
+        call path%choose_branch(1, err)
+        call check('choose_branch after the path moved on: FRICONT_ERR_ORDER', &
+                   err%status == FRICONT_ERR_ORDER, err%message)
+
+        call read_case(data//'vertex-start', v)
+        call make_problem(v, prob)
+        call path%create_affine(prob, v%f0, v%f1)
+        call path%set_window(v%alpha_start, v%alpha_end)
+        call path%start(v%alpha_start)
+        nb = path%branch_count()
+        call check('vertex start: three pieces leave it', nb == 3)
+        if (nb /= 3) return
+        found = .false.
+        ok = .true.
+        do k = 1, 3
+            cand(k) = path%branch(k)
+            ! (FRICONT codes: open 0, stick 1, slip+ 2, slip- 3)
+            found(1) = found(1) .or. all(cand(k)%classes == [FRICONT_OPEN, FRICONT_SLIP_PLUS])
+            found(2) = found(2) .or. all(cand(k)%classes == [FRICONT_SLIP_MINUS, FRICONT_SLIP_PLUS])
+            found(3) = found(3) .or. all(cand(k)%classes == [FRICONT_STICK, FRICONT_SLIP_MINUS])
+        end do
+        call check('vertex start: the three curves of the brute force', all(found))
+        do k = 1, 3
+            call path%start(v%alpha_start)
+            call path%choose_branch(k)
+            call path%run(reason)
+            pc = path%piece(1)
+            ok = ok .and. reason == FRICONT_END_WINDOW .and. all(pc%classes == cand(k)%classes)
+        end do
+        call check('vertex start: choose_branch(k) starts on the k-th piece', ok)
+    end subroutine bifurcations
 
 end program test_api
