@@ -447,6 +447,26 @@ int main(int argc, char **argv) {
             report("condensed: states carry no u", cs.u.empty() && cs.residual <= 1e-12,
                    std::to_string(cs.residual));
         }
+        // extended precision of a condensed W = diag(1/2, 1) (rows of norm 1): condition
+        // 2, so auto traces in double; on, in double-double; a bad mode throws
+        {
+            fricont::Problem diag = fricont::Problem::condensed(1, {0.5, 0.0, 0.0, 1.0});
+            diag.set_friction(0.5);
+            double kappa = 0;
+            bool ext = diag.extended_precision(&kappa);
+            report("W = diag(1/2, 1): condition estimate 2, auto traces in double",
+                   !ext && std::abs(kappa - 2) <= 1e-9, std::to_string(kappa));
+            diag.set_extended_precision(fricont::ExtendedPrecision::On);
+            report("extended precision on: in double-double", diag.extended_precision());
+            int32_t st = 0;
+            try {
+                diag.set_extended_precision(static_cast<fricont::ExtendedPrecision>(3));
+            } catch (const fricont::Error &e) {
+                st = e.status();
+            }
+            report("extended precision mode 3 throws FRICONT_ERR_RANGE", st == FRICONT_ERR_RANGE,
+                   std::to_string(st));
+        }
         // a throwing solve is a fatal solve failure
         int32_t status = 0;
         try {

@@ -65,6 +65,15 @@ enum class Storage : int32_t {
     Upper = FRICONT_STORAGE_UPPER,
 };
 
+/// Whether W and the condensed loads are carried beyond double precision (see
+/// `fricont_problem_set_extended_precision`).
+enum class ExtendedPrecision : int32_t {
+    /// Where the refinement is cheap, or W is ill-conditioned and it is affordable.
+    Auto = 0,
+    On = 1,
+    Off = 2,
+};
+
 /// What a step found (the positive outcomes of `fricont_path_step`).
 enum class Outcome : int32_t {
     Transition = FRICONT_TRANSITION,
@@ -376,6 +385,19 @@ public:
     /// (no thread started). Results agree with one thread to rounding. Throws on a bad
     /// count.
     void set_threads(int64_t threads) { check(fricont_problem_set_threads(h_, threads)); }
+    /// Extended precision (default `Auto`; see `fricont_problem_set_extended_precision`):
+    /// a change drops the factorisation, the next build factorises again.
+    void set_extended_precision(ExtendedPrecision mode) {
+        check(fricont_problem_set_extended_precision(h_, static_cast<int32_t>(mode)));
+    }
+    /// Whether the problem is traced in extended precision (builds it if needed; throws
+    /// the build's errors); `*w_condition`, when not null, receives the estimate of the
+    /// 2-norm condition number of the equilibrated W (dimensionless).
+    bool extended_precision(double *w_condition = nullptr) {
+        int32_t e = 0;
+        check(fricont_problem_extended_precision(h_, &e, w_condition));
+        return e != 0;
+    }
     /// Validates and factorises now (optional).
     void build() { check(fricont_problem_build(h_)); }
     /// Number of dofs n.
