@@ -352,16 +352,25 @@ class Problem:
         solves, products with W), each on a private pool stopped when the call ends. The
         load and monitor callables still run on the calling thread. Results agree with
         one thread's to rounding.
+    extended_precision : "auto" (default), "on" or "off": whether W and the condensed
+        loads are carried beyond double precision (mixed-precision refinement with the
+        Cholesky factor of A; slender bodies, whose W is ill-conditioned). "auto" refines
+        where that is cheap (small problems), or where W's condition estimate exceeds 1e6
+        and the refinement costs at most about max(20 x the factorisation, 1e11
+        operations); see the properties ``extended_precision`` and
+        ``w_condition_estimate`` for what was chosen.
 
     Duplicate entries (a COO matrix, or a CSR matrix without canonical format) are summed,
     as by every fricont interface (C, C++, Fortran, the CLI's Matrix Market files).
 
     Raises ValueError (invalid data: dimensions, NaN/Inf, complex values with a nonzero
-    imaginary part, not symmetric, F < 0, r <= 0, threads outside 1..1024) and
+    imaginary part, not symmetric, F < 0, r <= 0, threads outside 1..1024,
+    extended_precision not one of the three) and
     NotPositiveDefinite (A not SPD, with the failing pivot; B rank-deficient).
     """
 
-    def __init__(self, A, N, T, friction=0.3, gap=None, r=None, storage="full", threads=1):
+    def __init__(self, A, N, T, friction=0.3, gap=None, r=None, storage="full", threads=1,
+                 extended_precision="auto"):
         a = _csr("A", A)
         n = _csr("N", N)
         t = _csr("T", T)
@@ -378,7 +387,8 @@ class Problem:
             if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
                 raise ValueError(f"threads = {threads!r}: expected an integer in 1..1024")
             self._core = _core.Problem(
-                a, n, t, fr_list, g, None if r is None else float(r), storage, int(threads)
+                a, n, t, fr_list, g, None if r is None else float(r), storage, int(threads),
+                str(extended_precision),
             )
         except Exception as err:  # noqa: BLE001
             raise _reraise(err) from None
@@ -402,7 +412,8 @@ class Problem:
     def extended_precision(self) -> bool:
         """Whether W and the condensed loads are carried beyond double precision.
 
-        Chosen automatically: small problems always, and problems whose W is
+        As the constructor's ``extended_precision`` says: "on" always, "off" never,
+        "auto" (the default) small problems always, and problems whose W is
         ill-conditioned (``w_condition_estimate`` above 1e6) where the refinement costs at
         most max(20 times the factorisation of A, 1e11) operations. When False, the rounding
         of W moves transition points by up to about 50 * ``w_condition_estimate`` * 1.1e-16,

@@ -86,6 +86,7 @@ class Problem:
         r: Optional[float] = None,
         storage: str = "full",
         threads: int = 1,
+        extended_precision: str = "auto",
     ) -> None: ...
     @property
     def n(self) -> int: ...

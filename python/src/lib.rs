@@ -154,7 +154,7 @@ impl Problem {
     /// 1..=1024, NotPositiveDefinite when A is not SPD or B is rank-deficient.
     #[new]
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (a, n, t, friction, gap, r, storage, threads))]
+    #[pyo3(signature = (a, n, t, friction, gap, r, storage, threads, extended_precision))]
     fn new(
         py: Python<'_>,
         a: CsrArgs<'_>,
@@ -165,7 +165,18 @@ impl Problem {
         r: Option<f64>,
         storage: &str,
         threads: usize,
+        extended_precision: &str,
     ) -> PyResult<Self> {
+        let extended = match extended_precision {
+            "auto" => fricont::ExtendedPrecision::Auto,
+            "on" => fricont::ExtendedPrecision::On,
+            "off" => fricont::ExtendedPrecision::Off,
+            s => {
+                return Err(PyValueError::new_err(format!(
+                    "extended_precision = {s:?}: expected \"auto\", \"on\" or \"off\""
+                )));
+            }
+        };
         let storage = match storage {
             "full" => Storage::Full,
             "lower" => Storage::Lower,
@@ -179,7 +190,9 @@ impl Problem {
         let a = csr("A", a.0, a.1, a.2, a.3)?;
         let nm = csr("N", n.0, n.1, n.2, n.3)?;
         let tm = csr("T", t.0, t.1, t.2, t.3)?;
-        let mut b = ProblemBuilder::new(a, storage, nm, tm).threads(threads);
+        let mut b = ProblemBuilder::new(a, storage, nm, tm)
+            .threads(threads)
+            .extended_precision(extended);
         b = if friction.len() == 1 {
             b.friction_uniform(friction[0])
         } else {

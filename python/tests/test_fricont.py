@@ -88,6 +88,13 @@ def test_one_node_sticks_then_slips_at_the_hand_derived_alpha():
     assert prob.extended_precision is True
     assert path.to_dict()["precision"] == {
         "extended": True, "w_condition_estimate": prob.w_condition_estimate}
+    # ... unless told not to; either way the same event.
+    off = fricont.Problem(A, [[1.0, 0.0]], [[0.0, 1.0]], friction=0.5, extended_precision="off")
+    assert off.extended_precision is False
+    e_off = off.trace(f0=[1.0, 0.0], f1=[0.0, 1.0], window=(0.0, 2.0)).events[0]
+    assert abs(e_off.alpha - 0.5) <= 1e-14
+    with pytest.raises(ValueError, match="extended_precision"):
+        fricont.Problem(A, [[1.0, 0.0]], [[0.0, 1.0]], extended_precision="yes")
 
 
 def test_sample_events_equal_the_cli(sample, tmp_path):
