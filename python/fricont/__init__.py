@@ -479,8 +479,9 @@ class Problem:
         ``monitor``), so threads can trace different problems at once.
 
         Raises: ValueError for bad arguments (``guess`` not 2p finite values, ``branch``
-        negative); UsageError when ``branch`` > 0 is not an index of
-        ``start_branches`` (with the path, started on its first branch, as ``err.path``);
+        negative); UsageError when ``branch`` is not below the number of pieces leaving the
+        start point (``len(start_branches)``, or 1 when it lists none; the message says
+        how many; the path, started on the first, is ``err.path``);
         SolveError when the start solve fails; an
         exception raised inside ``load``/``dload``/``monitor`` stops the path and is
         re-raised with what was traced kept on it as ``err.path`` (a :class:`Path`; after

@@ -498,10 +498,17 @@ impl Path {
                         path.start(*alpha, guess.as_deref()).map_err(to_py)?;
                         *self.start_branches.lock().map_err(poisoned)? = path.branches().to_vec();
                         // (branch 0 is the piece the start took, also when it is the only one)
-                        if let Some(k) = *branch
-                            && (k > 0 || !path.branches().is_empty())
-                        {
-                            path.choose_branch(k).map_err(to_py)?;
+                        if let Some(k) = *branch {
+                            let offered = path.branches().len().max(1);
+                            if k >= offered {
+                                return Err(UsageError::new_err(format!(
+                                    "branch = {k}: {offered} piece{} the start point toward alpha_end (branch counts from 0)",
+                                    if offered > 1 { "s leave" } else { " leaves" }
+                                )));
+                            }
+                            if k > 0 {
+                                path.choose_branch(k).map_err(to_py)?;
+                            }
                         }
                     }
                     Begin::Branch(k) => path.choose_branch(*k).map_err(to_py)?,

@@ -500,9 +500,17 @@ def test_branch_starts_on_each_piece_leaving_a_zero_force_vertex():
         other = prob.trace(case["f0"], case["f1"], window=window, branch=k)
         assert other.pieces[0].classes == cl and other.end_reason == "window"
         assert [b.classes for b in other.start_branches] == offered
-    with pytest.raises(fricont.UsageError) as err:
+    with pytest.raises(fricont.UsageError, match="3 pieces leave the start point") as err:
         prob.trace(case["f0"], case["f1"], window=window, branch=3)
     assert err.value.path.pieces[0].classes == offered[0]
+    # (one piece leaves the sample's start: branch 0 is it, branch 1 an error)
+    sample = fricont.read_case(SAMPLE)
+    sp = fricont.Problem(sample["A"], sample["N"], sample["T"], friction=sample["friction"])
+    sw = (sample["alpha_start"], sample["alpha_end"])
+    assert same_path(sp.trace(sample["f0"], sample["f1"], window=sw, branch=0),
+                     sp.trace(sample["f0"], sample["f1"], window=sw))
+    with pytest.raises(fricont.UsageError, match="1 piece leaves the start point"):
+        sp.trace(sample["f0"], sample["f1"], window=sw, branch=1)
     with pytest.raises(ValueError, match="branch"):
         prob.trace(case["f0"], case["f1"], window=window, branch=-1)
 
