@@ -442,12 +442,22 @@ class Problem:
         max_alpha_step: Optional[float] = None,
         guess=None,
         branch: Optional[int] = None,
+        basis=None,
+        weights: Optional[Callable[[float], Any]] = None,
     ) -> Path:
         """Traces the solution path over ``window = (alpha_start, alpha_end)``.
 
         Affine load: ``f(alpha) = f0 + alpha * f1`` (length-n arrays, force units).
         General load: ``load(alpha)`` returns f (length n), ``dload(alpha)`` its derivative
-        (central differences when None); ``n`` defaults to the problem's n.
+        (central differences when None); ``n`` defaults to the problem's n. Each evaluation
+        costs a solve with the Cholesky factor of A.
+        Basis load: ``f(alpha) = sum_j phi_j(alpha) basis[j]``, ``basis`` k vectors of
+        length n, ``weights(alpha)`` returns ``(phi, dphi)``, the k weights and their
+        derivatives. Each vector is condensed once, so an evaluation costs O(k p) instead
+        of a solve with A: the way to trace an oscillating or otherwise nonlinear load on
+        a large mesh (on a 308,160-dof mesh, ``f0 + (m + h sin(20 alpha)) f1`` over a
+        period, 1022 events, traced in 1.7 s as a basis load and in 719 s as a general
+        one).
 
         ``alpha_start`` (default ``window[0]``) is where the fixed-alpha solve starts the
         path; it then goes toward ``window[1]``, through folds, until alpha leaves the
@@ -478,13 +488,15 @@ class Problem:
         The GIL is released while tracing (re-acquired only to call ``load``, ``dload`` or
         ``monitor``), so threads can trace different problems at once.
 
-        Raises: ValueError for bad arguments (``guess`` not 2p finite values, ``branch``
+        Raises: ValueError for bad arguments (more than one load or none, ``guess`` not 2p
+        finite values, ``weights`` returning other than two length-k arrays, ``branch``
         negative); UsageError when ``branch`` is not below the number of pieces leaving the
         start point (``len(start_branches)``, or 1 when it lists none; the message says
         how many; the path, started on the first, is ``err.path``);
         SolveError when the start solve fails; an
-        exception raised inside ``load``/``dload``/``monitor`` stops the path and is
-        re-raised with what was traced kept on it as ``err.path`` (a :class:`Path`; after
+        exception raised inside ``load``/``dload``/``weights``/``monitor`` stops the path
+        and is re-raised with what was traced kept on it as ``err.path`` (a :class:`Path`;
+        after
         an exception of ``monitor`` it is stopped, ``end_reason == "stopped"``, and can be
         resumed); other numerical failures raise NumericalError, also with ``err.path``.
         """
@@ -500,7 +512,24 @@ class Problem:
         ):
             raise ValueError(f"branch = {branch!r}: expected None or an integer >= 0")
         b = None if branch is None else int(branch)
-        if load is not None:
+        if basis is not None or weights is not None:
+            if f0 is not None or f1 is not None or load is not None:
+                raise ValueError("give one load: f0 and f1, load=, or basis= with weights=")
+            if basis is None or weights is None or not callable(weights):
+                raise ValueError("a basis load needs basis= (the vectors f_j) and a callable weights=")
+            vectors = [_vector(f"basis[{j}]", v) for j, v in enumerate(basis)]
+
+            def pair(a):
+                r = weights(a)
+                if not isinstance(r, (tuple, list)) or len(r) != 2:
+                    raise ValueError("weights(alpha) must return a pair (phi, dphi)")
+                return _vector("weights phi", r[0]), _vector("weights dphi", r[1])
+
+            try:
+                core = self._core.trace_basis(vectors, pair, win, a0, ms, h, monitor, g, b)
+            except Exception as err:  # noqa: BLE001
+                raise _reraise(err) from None
+        elif load is not None:
             if f0 is not None or f1 is not None:
                 raise ValueError("give either f0 and f1 (affine load) or load=, not both")
             # (the returned vectors through _vector: a complex f is an error, not its real

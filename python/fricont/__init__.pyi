@@ -113,6 +113,8 @@ class Problem:
         max_alpha_step: Optional[float] = None,
         guess: Optional[npt.ArrayLike] = None,
         branch: Optional[int] = None,
+        basis: Optional[Sequence[npt.ArrayLike]] = None,
+        weights: Optional[Callable[[float], Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
     ) -> Path: ...
 
 def read_case(directory: Any) -> dict[str, Any]: ...

@@ -272,6 +272,60 @@ impl Problem {
         self.trace(py, load, opts, monitor, None, guess, branch)
     }
 
+    /// Traces a basis load `f(α) = Σ_j φ_j(α) f_j`: `vectors` the f_j (n values each),
+    /// `weights(alpha)` returns `(phi, dphi)`, the k weights and their derivatives. Each
+    /// vector is condensed once, so an evaluation costs O(k p), not a solve with A. An
+    /// exception inside `weights` stops the path; it is kept on the path and re-raised by
+    /// the Python layer.
+    #[allow(clippy::too_many_arguments)]
+    #[pyo3(signature = (vectors, weights, window, alpha_start, max_steps, max_alpha_step, monitor, guess, branch))]
+    fn trace_basis(
+        &self,
+        py: Python<'_>,
+        vectors: Vec<PyReadonlyArray1<'_, f64>>,
+        weights: Py<PyAny>,
+        window: (f64, f64),
+        alpha_start: Option<f64>,
+        max_steps: Option<usize>,
+        max_alpha_step: Option<f64>,
+        monitor: Option<Py<PyAny>>,
+        guess: Option<PyReadonlyArray1<'_, f64>>,
+        branch: Option<usize>,
+    ) -> PyResult<Path> {
+        let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
+        let guess = guess
+            .map(|g| g.as_slice().map(<[f64]>::to_vec))
+            .transpose()?;
+        let vectors = vectors
+            .iter()
+            .map(|v| v.as_slice().map(<[f64]>::to_vec))
+            .collect::<Result<Vec<_>, _>>()?;
+        let slot: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
+        let keep = slot.clone();
+        let w = Box::new(move |alpha: f64, phi: &mut [f64], dphi: &mut [f64]| {
+            Python::attach(|py| -> Result<(), LoadFailure> {
+                let fail = |e: PyErr| {
+                    let message = format!("weights raised {e}");
+                    if let Ok(mut s) = keep.lock() {
+                        s.get_or_insert(e);
+                    }
+                    LoadFailure { code: 1, message }
+                };
+                let v = weights.call1(py, (alpha,)).map_err(fail)?;
+                let (p, d): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
+                    v.bind(py).extract().map_err(|e: PyErr| {
+                        fail(PyValueError::new_err(format!(
+                            "weights must return a pair (phi, dphi): {e}"
+                        )))
+                    })?;
+                copy_floats(py, &p, phi, "weights (phi)", "k").map_err(fail)?;
+                copy_floats(py, &d, dphi, "weights (dphi)", "k").map_err(fail)
+            })
+        }) as fricont::load::WeightsFn;
+        let load = Load::basis(vectors, w).map_err(to_py)?;
+        self.trace(py, load, opts, monitor, Some(slot), guess, branch)
+    }
+
     /// Traces a general load: `load(alpha)` returns f (n values); `dload(alpha)` its
     /// derivative (central differences when None). An exception inside either stops the
     /// path; it is kept on the path and re-raised by the Python layer.
@@ -308,25 +362,7 @@ impl Problem {
                         LoadFailure { code: 1, message }
                     };
                     let v = callable.call1(py, (alpha,)).map_err(fail)?;
-                    let np = py.import("numpy").map_err(fail)?;
-                    let arr = np
-                        .call_method1("ascontiguousarray", (v, "float64"))
-                        .map_err(fail)?;
-                    let arr: PyReadonlyArray1<'_, f64> = arr.extract().map_err(|e: PyErr| {
-                        fail(PyValueError::new_err(format!(
-                            "{what} must return a 1-D array of n floats: {e}"
-                        )))
-                    })?;
-                    let s = arr.as_slice().map_err(|e| fail(e.into()))?;
-                    if s.len() != out.len() {
-                        return Err(fail(PyValueError::new_err(format!(
-                            "{what} returned {} values, expected n = {}",
-                            s.len(),
-                            out.len()
-                        ))));
-                    }
-                    out.copy_from_slice(s);
-                    Ok(())
+                    copy_floats(py, v.bind(py), out, what, "n").map_err(fail)
                 })
             }) as fricont::load::VectorFn
         };
@@ -335,6 +371,35 @@ impl Problem {
         let load = Load::general(n, f, df);
         self.trace(py, load, opts, monitor, Some(slot), guess, branch)
     }
+}
+
+/// Copies `v` (anything numpy reads as a 1-D float64 array) into `out`: ValueError when
+/// it is not one, or when its length is not `out.len()` (`len_name` names that length).
+fn copy_floats(
+    py: Python<'_>,
+    v: &Bound<'_, PyAny>,
+    out: &mut [f64],
+    what: &str,
+    len_name: &str,
+) -> PyResult<()> {
+    let arr = py
+        .import("numpy")?
+        .call_method1("ascontiguousarray", (v, "float64"))?;
+    let arr: PyReadonlyArray1<'_, f64> = arr.extract().map_err(|e: PyErr| {
+        PyValueError::new_err(format!(
+            "{what} must return a 1-D array of {len_name} floats: {e}"
+        ))
+    })?;
+    let s = arr.as_slice()?;
+    if s.len() != out.len() {
+        return Err(PyValueError::new_err(format!(
+            "{what} returned {} values, expected {len_name} = {}",
+            s.len(),
+            out.len()
+        )));
+    }
+    out.copy_from_slice(s);
+    Ok(())
 }
 
 /// The path options of `trace`: ValueError for `max_steps` = 0 (the other values are

@@ -145,6 +145,47 @@ def test_a_general_load_equal_to_the_affine_one_gives_the_same_events(sample):
         assert abs(e.alpha - r.alpha) <= 1e-10
 
 
+def test_a_basis_load_reparametrised_by_sinh_has_the_events_at_asinh(sample):
+    # f(s) = f0 + sinh(s) f1 is the affine load at alpha = sinh(s): the events of the basis
+    # load are at s = asinh(alpha_k) of the affine ones (a reparametrisation, metamorphic).
+    ref = trace_sample(sample)
+    prob = fricont.Problem(sample["A"], sample["N"], sample["T"], friction=sample["friction"])
+    f0, f1 = sample["f0"], sample["f1"]
+    path = prob.trace(basis=[f0, f1], weights=lambda s: ([1.0, np.sinh(s)], [0.0, np.cosh(s)]),
+                      window=(np.arcsinh(-0.5), np.arcsinh(1.5)))
+    assert path.end_reason == "window" and len(path.events) == len(ref.events)
+    for e, r in zip(path.events, ref.events):
+        assert (e.node, e.from_class, e.to_class, e.fold) == (r.node, r.from_class, r.to_class, r.fold)
+        assert abs(np.sinh(e.alpha) - r.alpha) <= 1e-10 * max(1.0, abs(r.alpha))
+
+
+def test_basis_load_errors(sample):
+    prob = fricont.Problem(sample["A"], sample["N"], sample["T"], friction=sample["friction"])
+    f0, f1 = sample["f0"], sample["f1"]
+    win = (-0.5, 1.5)
+    with pytest.raises(ValueError, match="one load"):
+        prob.trace(f0, f1, window=win, basis=[f0], weights=lambda a: ([1.0], [0.0]))
+    with pytest.raises(ValueError, match="weights"):
+        prob.trace(window=win, basis=[f0, f1])
+    with pytest.raises(ValueError, match="expected k = 2"):
+        prob.trace(window=win, basis=[f0, f1], weights=lambda a: ([1.0], [0.0]))
+    with pytest.raises(ValueError, match="pair"):
+        prob.trace(window=win, basis=[f0, f1], weights=lambda a: np.array([1.0, a]))
+    with pytest.raises(ValueError, match="basis"):
+        prob.trace(window=win, basis=[f0, f1[:-1]], weights=lambda a: ([1.0, a], [0.0, 1.0]))
+
+    def weights(a):
+        if a > 0.5:
+            raise RuntimeError("no weights beyond alpha = 0.5")
+        return [1.0, a], [0.0, 1.0]
+
+    with pytest.raises(RuntimeError, match="beyond") as info:
+        prob.trace(window=win, basis=[f0, f1], weights=weights)
+    kept = info.value.path
+    assert kept.end_reason == "failed" and len(kept.events) > 0
+    assert all(e.alpha <= 0.5 + 1e-12 for e in kept.events)
+
+
 def test_a_load_that_raises_keeps_the_traced_part(sample):
     ref = trace_sample(sample)
     cut = 0.5
