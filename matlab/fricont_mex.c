@@ -74,7 +74,7 @@ static void raise_error(const char *id, const char *fmt, ...) {
 
 enum { W_IDLE, W_JOB, W_RUNNING, W_WAIT_REPLY, W_REPLY_READY, W_DONE, W_QUIT };
 enum { JOB_START, JOB_RUN, JOB_STEP, JOB_SOLUTIONS_AT, JOB_CHOOSE_BRANCH };
-enum { REQ_F, REQ_DF, REQ_MONITOR };
+enum { REQ_F, REQ_DF, REQ_MONITOR, REQ_WEIGHTS };
 
 typedef struct worker {
     pthread_t thread;
@@ -99,6 +99,8 @@ typedef struct worker {
     int64_t req_n;
     int64_t req_transitions, req_first, req_end;
     int32_t reply_code;
+    /* a basis load's weights: phi then phi' (2k values) as MATLAB returns them */
+    double *weights_buf;
 } worker;
 
 /* Hands a request to MATLAB's thread and waits for the reply: 0, or nonzero to refuse
@@ -134,6 +136,17 @@ static int32_t load_cb(double alpha, double *out, int64_t n, void *ud) {
 
 static int32_t dload_cb(double alpha, double *out, int64_t n, void *ud) {
     return worker_callback((worker *)ud, REQ_DF, alpha, out, n, 0, 0, 0);
+}
+
+/* A basis load's weights: one request for [phi; phi'] (2k values), split here. */
+static int32_t weights_cb(double alpha, double *phi, double *dphi, int64_t k, void *ud) {
+    worker *w = (worker *)ud;
+    int32_t code = worker_callback(w, REQ_WEIGHTS, alpha, w->weights_buf, 2 * k, 0, 0, 0);
+    if (code == 0) {
+        memcpy(phi, w->weights_buf, sizeof(double) * (size_t)k);
+        memcpy(dphi, w->weights_buf + k, sizeof(double) * (size_t)k);
+    }
+    return code;
 }
 
 static int32_t monitor_cb(double alpha, int64_t transitions, int64_t first, int64_t end,
@@ -223,6 +236,7 @@ static void worker_stop(worker *w) {
     pthread_cond_destroy(&w->cv);
     pthread_mutex_destroy(&w->mu);
     free(w->job_guess);
+    free(w->weights_buf);
     free(w);
 }
 
@@ -505,7 +519,9 @@ static void job_outputs(int nlhs, mxArray *plhs[], entry *e, int32_t status, int
         v[2] = (double)(w->req_first + 1); /* the new events, from 1, last included */
         v[3] = (double)w->req_end;
     } else if (waiting) {
-        plhs[0] = mxCreateString(e->w->req_kind == REQ_DF ? "df" : "f");
+        plhs[0] = mxCreateString(e->w->req_kind == REQ_DF        ? "df"
+                                 : e->w->req_kind == REQ_WEIGHTS ? "w"
+                                                                 : "f");
         plhs[1] = mxCreateDoubleScalar(e->w->req_alpha);
     } else {
         plhs[0] = mxCreateString("done");
@@ -714,6 +730,9 @@ static void cmd_problem_set(int nrhs, const mxArray *prhs[], const char *cmd) {
     }
 }
 
+/* ('path_new_affine', prob, f0, f1), ('path_new_general', prob, has_derivative) or
+ * ('path_new_basis', prob, V): V n-by-k, the vectors of a basis load whose weights
+ * MATLAB returns as [phi; phi'] (request 'w'). */
 static void cmd_path_new(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[],
                          const char *cmd, int general) {
     (void)nlhs;
@@ -721,7 +740,30 @@ static void cmd_path_new(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prh
     entry *pe = lookup(prhs[1], KIND_PROBLEM);
     fricont_path *path = NULL;
     worker *w = NULL;
-    if (!general) {
+    if (general == 2) {
+        const mxArray *v = prhs[2];
+        if (!mxIsDouble(v) || mxIsComplex(v) || mxIsSparse(v) ||
+            (int64_t)mxGetM(v) != pe->n || mxGetN(v) < 1)
+            mexErrMsgIdAndTxt("fricont:argument",
+                              "fricont: the basis vectors must be a real dense n-by-k matrix "
+                              "(n = %lld rows, k >= 1 columns)",
+                              (long long)pe->n);
+        int64_t k = (int64_t)mxGetN(v);
+        w = worker_new(NULL);
+        if (!w) mexErrMsgIdAndTxt("fricont:thread", "fricont: cannot start a worker thread");
+        w->weights_buf = (double *)calloc((size_t)(2 * k), sizeof(double));
+        if (!w->weights_buf) {
+            worker_stop(w);
+            mexErrMsgIdAndTxt("fricont:memory", "fricont: out of memory");
+        }
+        int32_t st =
+            fricont_path_new_basis(pe->problem, mxGetPr(v), pe->n, k, weights_cb, w, NULL, &path);
+        if (st < 0) {
+            worker_stop(w);
+            raise_status(st, "path");
+        }
+        w->path = path;
+    } else if (!general) {
         const double *f0 = get_vector(prhs[2], pe->n, "f0");
         const double *f1 = get_vector(prhs[3], pe->n, "f1");
         check(fricont_path_new_affine(pe->problem, f0, f1, pe->n, &path), "path");
@@ -922,6 +964,8 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[]) {
         if (nlhs > 1) plhs[1] = mxCreateDoubleScalar(d);
     } else if (strcmp(cmd, "path_new_affine") == 0) {
         cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, 0);
+    } else if (strcmp(cmd, "path_new_basis") == 0) {
+        cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, 2);
     } else if (strcmp(cmd, "path_new_general") == 0) {
         cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, 1);
     } else if (strcmp(cmd, "path_set") == 0) {

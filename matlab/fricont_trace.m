@@ -4,6 +4,7 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %   res = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1])
 %   res = fricont_trace(A, N, T, f0, f1, F, [alpha0 alpha1], opts)
 %   res = fricont_trace(A, N, T, @f, @df, F, [alpha0 alpha1], opts)
+%   res = fricont_trace(A, N, T, V, @weights, F, [alpha0 alpha1], opts)
 %
 %   A      n-by-n stiffness, sparse, symmetric positive definite (Dirichlet dofs
 %          eliminated). Passed in MATLAB's own CSC form, not copied before the library
@@ -14,7 +15,13 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %          Or a function handle f(alpha) returning an n-vector, and a function handle
 %          df(alpha) for f'(alpha) or [] (then central differences are used). MATLAB
 %          evaluates them between library calls; an error they raise stops the trace
-%          and is reported by fricont_trace.
+%          and is reported by fricont_trace. Each evaluation costs a solve with A.
+%          Or a basis load f(alpha) = V * phi(alpha): V an n-by-k matrix of fixed
+%          vectors and weights(alpha) a function handle returning the k-by-2 matrix
+%          [phi dphi] (the weights and their derivatives). Each column of V is condensed
+%          once, so an evaluation costs O(k p) instead of a solve with A: prefer it
+%          whenever the load is a combination of fixed vectors (an oscillating amplitude,
+%          several load cases), e.g. V = [f0 f1], weights = @(a) [1 0; sin(a) cos(a)].
 %   F      friction coefficient, a scalar or a p-vector (>= 0).
 %   [alpha0 alpha1]  the window: traced from alpha0 toward alpha1.
 %   opts   struct, all fields optional:
@@ -116,7 +123,14 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
   r = fricont_mex('problem_r', prob);
   n = size(A, 1);
 
-  if isa(f0, 'function_handle')
+  if isnumeric(f0) && isa(f1, 'function_handle')
+    if ndims(f0) ~= 2 || size(f0, 1) ~= size(A, 1) || size(f0, 2) < 1 || ~isreal(f0)
+      error('fricont:argument', ['fricont_trace: the basis vectors V must be a real ' ...
+            'n-by-k matrix (n = %d)'], size(A, 1));
+    end
+    load = struct('w', f1, 'k', size(f0, 2));
+    id = fricont_mex('path_new_basis', prob, full(double(f0)));
+  elseif isa(f0, 'function_handle')
     if ~isempty(f1) && ~isa(f1, 'function_handle')
       error('fricont:argument', 'fricont_trace: with a load function, df is a function handle or []');
     end

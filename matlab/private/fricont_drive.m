@@ -1,7 +1,8 @@
 function [status, count] = fricont_drive(id, load, n, job, varargin)
 %FRICONT_DRIVE Runs a library call on path id, evaluating the load function whenever
 %   the library asks for f(alpha) or f'(alpha), and the monitor after each transition
-%   point of a 'run' (see fricont_mex.c). For job 'run', varargin is {monitor}: a
+%   point of a 'run' (see fricont_mex.c); for a basis load, load.w(alpha) gives the
+%   k-by-2 weights [phi dphi] (load.k = k). For job 'run', varargin is {monitor}: a
 %   function handle or [] (none). The functions are evaluated here, in MATLAB, between
 %   MEX calls. An error in the load function is kept, the library is told to stop (the
 %   path ends, 'failed'), and the error is raised afterwards as fricont:load; an error in
@@ -49,16 +50,22 @@ function [status, count] = fricont_drive(id, load, n, job, varargin)
       end
     elseif isempty(failure) && isempty(monitor_failure)
       try
-        if strcmp(what, 'f')
+        if strcmp(what, 'w')
+          v = load.w(value);
+          if ~isnumeric(v) || ~isreal(v) || ~isequal(size(v), [load.k 2])
+            error('fricont:load', ['the weights function must return a real k-by-2 matrix ' ...
+                  '[phi dphi] (k = %d), got %s'], load.k, mat2str(size(v)));
+          end
+        elseif strcmp(what, 'f')
           v = load.f(value);
         else
           v = load.df(value);
         end
-        if ~isnumeric(v) || ~isreal(v) || numel(v) ~= n
+        if ~strcmp(what, 'w') && (~isnumeric(v) || ~isreal(v) || numel(v) ~= n)
           error('fricont:load', ['the load function must return a real vector of ' ...
                 'n = %d values (got %d)'], n, numel(v));
         end
-        v = full(double(v(:)));
+        v = full(double(v(:)));             % (weights: [phi; dphi])
       catch err
         failure = err;
         failed_at = value;

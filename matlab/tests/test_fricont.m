@@ -42,6 +42,19 @@ function failures = test_fricont(case_dir, out_dir)
   failures = failures + check('solutions_at through a load function: same u', numel(Sh) == 1 && ...
                     norm(Sh(1).u - S(1).u, inf) <= 1e-8 * norm(S(1).u, inf));
 
+  %    The same as a basis load, V = [f0 f1] with weights [1 0; sinh(s) cosh(s)]: the
+  %    events at asinh of the affine ones too; weights of the wrong shape are an error
+  %    naming it.
+  pbas = fricont_trace(c.A, c.N, c.T, [c.f0 c.f1], @(s) [1 0; sinh(s) cosh(s)], c.F, swin, opts);
+  failures = failures + check('basis load f0 + sinh(s) f1: the affine events at asinh', ...
+                    strcmp(pbas.end_reason, 'window') && numel(pbas.events) == numel(ev) && ...
+                    isequal([pbas.events.node], [ev.node]) && isequal({pbas.events.to}, {ev.to}) && ...
+                    max(abs(sinh([pbas.events.alpha]) - [ev.alpha]) ./ max(1, abs([ev.alpha]))) <= 1e-9);
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, [c.f0 c.f1], @(s) [1; s], c.F, swin, opts));
+  failures = failures + check('basis weights not k-by-2: fricont:load naming it', ...
+                    strcmp(ident, 'fricont:load') && ~isempty(strfind(msg, 'k-by-2')), [ident ' ' msg]);
+  clear pbas;
+
   % 4. The lower triangle of A with storage 'lower' gives the same path as the full
   %    matrix with the same entries (A.mtx need not be bit-symmetric, and a shallow
   %    crossing can amplify a last-bit difference between the triangles well above 1e-12).
