@@ -269,6 +269,47 @@ int main(int argc, char **argv) {
                d.empty() && gev.size() == ref.size(), d);
     }
 
+    //    The same as a basis load (vectors f0, f1; weights 1, sinh): the same events; an
+    //    exception thrown by the weights comes back out of the call that evaluated them.
+    {
+        fricont::Path b = fricont::Path::basis(
+            prob, {c.f0, c.f1}, [](double a, double *phi, double *dphi, std::size_t k) {
+                if (k != 2) throw std::logic_error("k");
+                phi[0] = 1;
+                phi[1] = std::sinh(a);
+                dphi[0] = 0;
+                dphi[1] = std::cosh(a);
+            });
+        b.set_window(std::asinh(c.alpha_start), std::asinh(c.alpha_end));
+        b.start(std::asinh(c.alpha_start));
+        fricont::EndReason r = b.run();
+        std::vector<fricont::Event> bev = b.events();
+        std::string d = compare(bev, ref, 1e-9, [](double a) { return std::asinh(a); }, ref.size());
+        report("basis load: events at asinh(reference)",
+               r == fricont::EndReason::Window && d.empty() && bev.size() == ref.size(), d);
+        fricont::Path t = fricont::Path::basis(prob, {c.f0, c.f1},
+                                               [](double, double *, double *, std::size_t) {
+                                                   throw std::domain_error("no weights");
+                                               });
+        t.set_window(c.alpha_start, c.alpha_end);
+        std::string caught;
+        try {
+            t.start(c.alpha_start);
+        } catch (const std::domain_error &e) {
+            caught = e.what();
+        }
+        report("basis load: a throwing weights function's exception is rethrown",
+               caught == "no weights", caught);
+        int32_t st = 0;
+        try {
+            fricont::Path::basis(prob, {c.f0, {1.0}}, [](double, double *, double *, std::size_t) {});
+        } catch (const fricont::Error &e) {
+            st = e.status();
+        }
+        report("basis load: vectors of different lengths throw FRICONT_ERR_LENGTH",
+               st == FRICONT_ERR_LENGTH, std::to_string(st));
+    }
+
     // 5. An exception thrown by a load callback comes back out of the wrapper call (it
     //    never crosses the library) and the path ends, keeping what it traced.
     if (ev.size() >= 3) {

@@ -235,6 +235,8 @@ struct LoadContext {
     std::function<void(double, double *, std::size_t)> f;
     std::function<void(double, double *, std::size_t)> df;
     std::exception_ptr pending;
+    /// A basis load's weights (f and df empty then).
+    std::function<void(double, double *, double *, std::size_t)> w;
 };
 
 inline int32_t call_load(const std::function<void(double, double *, std::size_t)> &fn,
@@ -259,6 +261,19 @@ extern "C" inline int32_t fricont_cxx_dload_trampoline(double alpha, double *out
                                                        void *ud) {
     auto *ctx = static_cast<LoadContext *>(ud);
     return call_load(ctx->df, ctx, alpha, out, n);
+}
+
+extern "C" inline int32_t fricont_cxx_weights_trampoline(double alpha, double *phi,
+                                                         double *dphi, int64_t k, void *ud) {
+    auto *ctx = static_cast<LoadContext *>(ud);
+    try {
+        ctx->w(alpha, phi, dphi, static_cast<std::size_t>(k));
+        return 0;
+    } catch (...) {
+        // Never let an exception reach the library: keep it and return a code.
+        if (!ctx->pending) ctx->pending = std::current_exception();
+        return 1;
+    }
 }
 
 extern "C" inline void fricont_cxx_free_context(void *ud) {
@@ -469,11 +484,46 @@ public:
         return path;
     }
 
+    /// The weights of a basis load: writes φ_j(α) into `phi[0..k)` and φ_j'(α) into
+    /// `dphi[0..k)`. It may throw, as a `LoadFn`.
+    using WeightsFn = std::function<void(double alpha, double *phi, double *dphi, std::size_t k)>;
+
+    /// The basis load f(α) = Σ_j φ_j(α) f_j: `vectors` the k fixed vectors f_j (n values
+    /// each, copied), `weights` their weights. Each vector is condensed once, so that an
+    /// evaluation costs O(k p) where a `general` load costs a solve with A: prefer it
+    /// whenever the load is a combination of fixed vectors. Throws for no vectors,
+    /// vectors of different lengths, an empty `weights`, and the library's errors.
+    static Path basis(Problem &problem, const std::vector<std::vector<double>> &vectors,
+                      WeightsFn weights) {
+        if (!weights) throw Error(FRICONT_ERR_NULL, "fricont::Path::basis: empty weights function");
+        if (vectors.empty()) throw Error(FRICONT_ERR_LENGTH, "fricont::Path::basis: no vectors");
+        std::vector<double> flat;
+        flat.reserve(vectors.size() * vectors[0].size());
+        for (const auto &v : vectors) {
+            if (v.size() != vectors[0].size())
+                throw Error(FRICONT_ERR_LENGTH, "fricont::Path::basis: vectors differ in length");
+            flat.insert(flat.end(), v.begin(), v.end());
+        }
+        Path path(problem);
+        auto *ctx = new detail::LoadContext{nullptr, nullptr, nullptr, std::move(weights)};
+        path.ctx_ = ctx;
+        // The library owns ctx from here (freed exactly once, also when creation fails).
+        int32_t st = fricont_path_new_basis(
+            problem.get(), flat.data(), static_cast<int64_t>(vectors[0].size()),
+            static_cast<int64_t>(vectors.size()), detail::fricont_cxx_weights_trampoline, ctx,
+            detail::fricont_cxx_free_context, &path.h_);
+        if (st < 0) {
+            path.ctx_ = nullptr;
+            detail::check(st);
+        }
+        return path;
+    }
+
     /// A general load f(α) from a callable, with an optional derivative f'(α).
     static Path general(Problem &problem, LoadFn f, LoadFn df = nullptr) {
         if (!f) throw Error(FRICONT_ERR_NULL, "fricont::Path::general: empty load function");
         Path path(problem);
-        auto *ctx = new detail::LoadContext{std::move(f), std::move(df), nullptr};
+        auto *ctx = new detail::LoadContext{std::move(f), std::move(df), nullptr, nullptr};
         path.ctx_ = ctx;
         // The library owns ctx from here: it calls fricont_cxx_free_context exactly once
         // (also when the creation fails).
