@@ -725,6 +725,11 @@ static void cmd_problem_set(int nrhs, const mxArray *prhs[], const char *cmd) {
               "gap");
     } else if (strcmp(what, "r") == 0) {
         check(fricont_problem_set_r(e->problem, get_scalar(prhs[3], "r")), "r");
+    } else if (strcmp(what, "extended") == 0) {
+        /* 0 auto, 1 on, 2 off (the .m code maps the names) */
+        check(fricont_problem_set_extended_precision(
+                  e->problem, (int32_t)get_scalar(prhs[3], "extended_precision")),
+              "extended_precision");
     } else {
         mexErrMsgIdAndTxt("fricont:argument", "fricont: unknown problem setting '%s'", what);
     }
@@ -962,6 +967,15 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[]) {
         check(fricont_problem_r(e->problem, &r, &d), "r");
         plhs[0] = mxCreateDoubleScalar(r);
         if (nlhs > 1) plhs[1] = mxCreateDoubleScalar(d);
+    } else if (strcmp(cmd, "problem_precision") == 0) {
+        /* [extended, w_condition] = ('problem_precision', prob): builds the problem */
+        NEED(2);
+        entry *e = lookup(prhs[1], KIND_PROBLEM);
+        int32_t ext = 0;
+        double kappa = 0;
+        check(fricont_problem_extended_precision(e->problem, &ext, &kappa), "extended_precision");
+        plhs[0] = logical(ext);
+        if (nlhs > 1) plhs[1] = mxCreateDoubleScalar(kappa);
     } else if (strcmp(cmd, "path_new_affine") == 0) {
         cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, 0);
     } else if (strcmp(cmd, "path_new_basis") == 0) {

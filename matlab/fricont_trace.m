@@ -32,6 +32,10 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %            one alpha can have several solutions (large friction, folds); the solve
 %            returns one of them, and a guess that solves the problem is kept, so a
 %            known solution is traced from exactly),
+%          extended_precision ('auto' default, 'on' or 'off'): whether W and the
+%            condensed loads are carried beyond double precision (slender bodies, whose W
+%            is ill-conditioned); 'auto' refines where that is cheap (small problems) or
+%            where W's condition estimate exceeds 1e6 and the cost is moderate.
 %          start_branch (positive integer, default 1): where several pieces leave the
 %            start point toward alpha1 (res.start_branches), trace piece start_branch,
 %          max_alpha_step (alpha units, finite and > 0; default 1/8 of the window): the
@@ -67,6 +71,10 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %             continue it; FRICONT_CHOOSE_BRANCH follows one. Empty otherwise.
 %     start_branches  the same for the pieces that left the start point toward
 %             alpha1, where more than one did (empty otherwise).
+%     extended_precision, w_condition_estimate  whether the trace was in extended
+%             precision, and the estimate of the 2-norm condition number of the
+%             equilibrated W (in double, transition points can move by up to about
+%             50 * w_condition_estimate * 1.1e-16 relative to max(1, |alpha|)).
 %     n, p, r, window, and handle/load (used by fricont_solutions_at; the library path
 %     is freed when the last copy of the struct is cleared).
 %
@@ -81,7 +89,7 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
     error('fricont:argument', 'fricont_trace: opts must be a scalar struct');
   end
   valid = {'gap', 'r', 'storage', 'max_steps', 'zero_tol', 'guess', 'max_alpha_step', ...
-           'monitor', 'start_branch'};
+           'monitor', 'start_branch', 'extended_precision'};
   unknown = setdiff(fieldnames(opts), valid);
   if ~isempty(unknown)
     error('fricont:argument', 'fricont_trace: unknown option ''%s''; the options are: %s', ...
@@ -120,6 +128,15 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
   if isfield(opts, 'r')
     fricont_mex('problem_set', prob, 'r', double(opts.r));
   end
+  if isfield(opts, 'extended_precision')
+    mode = find(strcmp(opts.extended_precision, {'auto', 'on', 'off'}));
+    if ~ischar(opts.extended_precision) || isempty(mode)
+      error('fricont:argument', ['fricont_trace: opts.extended_precision must be ' ...
+            '''auto'', ''on'' or ''off''']);
+    end
+    fricont_mex('problem_set', prob, 'extended', mode - 1);
+  end
+  [extended, kappa] = fricont_mex('problem_precision', prob);
   r = fricont_mex('problem_r', prob);
   n = size(A, 1);
 
@@ -174,6 +191,8 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 
   res = fricont_mex('path_result', id);
   res.start_branches = start_branches;
+  res.extended_precision = extended;
+  res.w_condition_estimate = kappa;
   res.r = r;
   res.window = double(window(:).');
   res.handle = handle;

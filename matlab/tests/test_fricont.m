@@ -55,6 +55,26 @@ function failures = test_fricont(case_dir, out_dir)
                     strcmp(ident, 'fricont:load') && ~isempty(strfind(msg, 'k-by-2')), [ident ' ' msg]);
   clear pbas;
 
+  %    Extended precision: the sample is small, so auto refines it; off traces it in
+  %    double, to the same events. The one-node block A = diag(2, 1), N = [1 0],
+  %    T = [0 1] has W = diag(1/2, 1): condition 2.
+  failures = failures + check('extended precision: auto refines the sample', ...
+                    res.extended_precision && res.w_condition_estimate > 1);
+  poff = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, ...
+                       struct('gap', c.gap, 'extended_precision', 'off'));
+  failures = failures + check('extended precision off: in double, the same events', ...
+                    ~poff.extended_precision && numel(poff.events) == numel(ev) && ...
+                    isequal([poff.events.node], [ev.node]) && ...
+                    max(abs([poff.events.alpha] - [ev.alpha])) <= 1e-10);
+  blk = fricont_trace(sparse([2 0; 0 1]), sparse([1 0]), sparse([0 1]), [1; 0], [0; 1], 0.5, [0 1]);
+  failures = failures + check('W = diag(1/2, 1): condition estimate 2', ...
+                    abs(blk.w_condition_estimate - 2) <= 1e-9, sprintf('%.17g', blk.w_condition_estimate));
+  [ident, msg] = caught(@() fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, ...
+                                          struct('extended_precision', 'yes')));
+  failures = failures + check('extended precision ''yes'': fricont:argument', ...
+                    strcmp(ident, 'fricont:argument'), [ident ' ' msg]);
+  clear poff blk;
+
   % 4. The lower triangle of A with storage 'lower' gives the same path as the full
   %    matrix with the same entries (A.mtx need not be bit-symmetric, and a shallow
   %    crossing can amplify a last-bit difference between the triangles well above 1e-12).
