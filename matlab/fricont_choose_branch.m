@@ -31,11 +31,6 @@ function res = fricont_choose_branch(res, k, monitor)
   if ~isempty(monitor) && ~isa(monitor, 'function_handle')
     error('fricont:argument', 'fricont_choose_branch: monitor must be a function handle or []');
   end
-  id = res.handle.id;
-  fricont_drive(id, res.load, res.n, 'choose_branch', double(k));
-  fricont_drive(id, res.load, res.n, 'run', monitor);
-  cur = fricont_mex('path_result', id);
-  for f = fieldnames(cur).'
-    res.(f{1}) = cur.(f{1});
-  end
+  fricont_drive(res.handle.id, res.load, res.n, 'choose_branch', double(k));
+  res = fricont_resume(res, monitor);
 end

@@ -266,9 +266,6 @@ impl Problem {
     ) -> PyResult<Path> {
         let load = Load::affine(f0.as_slice()?.to_vec(), f1.as_slice()?.to_vec()).map_err(to_py)?;
         let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
-        let guess = guess
-            .map(|g| g.as_slice().map(<[f64]>::to_vec))
-            .transpose()?;
         self.trace(py, load, opts, monitor, None, guess, branch)
     }
 
@@ -293,9 +290,6 @@ impl Problem {
         branch: Option<usize>,
     ) -> PyResult<Path> {
         let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
-        let guess = guess
-            .map(|g| g.as_slice().map(<[f64]>::to_vec))
-            .transpose()?;
         let vectors = vectors
             .iter()
             .map(|v| v.as_slice().map(<[f64]>::to_vec))
@@ -346,9 +340,6 @@ impl Problem {
         branch: Option<usize>,
     ) -> PyResult<Path> {
         let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
-        let guess = guess
-            .map(|g| g.as_slice().map(<[f64]>::to_vec))
-            .transpose()?;
         let slot: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
         let wrap = |callable: Py<PyAny>, what: &'static str| {
             let slot = slot.clone();
@@ -435,9 +426,12 @@ impl Problem {
         opts: PathOptions,
         monitor: Option<Py<PyAny>>,
         load_error: Option<Arc<Mutex<Option<PyErr>>>>,
-        guess: Option<Vec<f64>>,
+        guess: Option<PyReadonlyArray1<'_, f64>>,
         branch: Option<usize>,
     ) -> PyResult<Path> {
+        let guess = guess
+            .map(|g| g.as_slice().map(<[f64]>::to_vec))
+            .transpose()?;
         let start = Begin::Start {
             alpha: opts.alpha_start,
             guess,
