@@ -150,8 +150,10 @@ impl Problem {
     /// Builds the problem (validation, Cholesky of A, Delassus operator) with the GIL
     /// released. `storage`: "full", "lower" or "upper". `threads`: those of the set-up
     /// and, where 2p ≥ 2048, of the trace's dense passes (private pools, see
-    /// `ProblemBuilder::threads`). Errors: ValueError for invalid data or threads outside
-    /// 1..=1024, NotPositiveDefinite when A is not SPD or B is rank-deficient.
+    /// `ProblemBuilder::threads`). `extended_precision`: "auto", "on" or "off"
+    /// (`ProblemBuilder::extended_precision`). Errors: ValueError for invalid data,
+    /// threads outside 1..=1024 or another precision mode, NotPositiveDefinite when A is
+    /// not SPD or B is rank-deficient.
     #[new]
     #[allow(clippy::too_many_arguments)]
     #[pyo3(signature = (a, n, t, friction, gap, r, storage, threads, extended_precision))]
