@@ -8,7 +8,8 @@
 //! piece the path came from, are exactly the continuations. So a transition not flagged
 //! as a bifurcation must have exactly one such piece, the one the path took; one flagged
 //! as a bifurcation must offer exactly those pieces in `branches()`. After a bifurcation
-//! where the library stops (`EndReason::Bifurcation`), `choose_branch` is exercised.
+//! where the library stops (`EndReason::Bifurcation`), `choose_branch` is exercised, on
+//! every candidate index in turn, and the path is checked on along the chosen branch.
 //! While the traced solution is symmetric, mirrored nodes switch together (same α, same
 //! classes, one event per node in node order) and the centre node is never in slip.
 
@@ -30,6 +31,8 @@ struct Stats {
     bifurcations: usize,
     stopped: usize,
     centre_touchdowns: usize,
+    /// Stops where branch 0, 1, 2 or a later one was chosen.
+    chosen: [usize; 3],
 }
 
 fn set(v: &[Vec<Class>]) -> BTreeSet<Vec<Class>> {
@@ -70,13 +73,17 @@ fn check_case(case: &Case, st: &mut Stats) {
                     offered.len()
                 );
                 let before = path.events().len();
-                path.choose_branch(0)
-                    .unwrap_or_else(|e| panic!("{ctx}: choose_branch(0): {e}"));
+                // Every candidate index is taken somewhere: the seed and the stops so far
+                // pick it.
+                let k = (case.seed as usize + st.stopped) % offered.len();
+                path.choose_branch(k)
+                    .unwrap_or_else(|e| panic!("{ctx}: choose_branch({k}): {e}"));
                 assert_eq!(
                     path.pieces().last().unwrap().classes,
-                    offered[0].classes,
+                    offered[k].classes,
                     "{ctx}: chosen branch"
                 );
+                st.chosen[k.min(2)] += 1;
                 (before..path.events().len(), true, offered)
             }
             StepOutcome::End(_) => break,
@@ -194,7 +201,10 @@ fn mirror_pairs() {
         check_case(&symmetric_case(seed, false), &mut st);
     }
     eprintln!("{st:?}");
-    assert!(st.degenerate >= 150 && st.bifurcations >= 10, "{st:?}");
+    assert!(
+        st.degenerate >= 150 && st.bifurcations >= 10 && st.chosen.iter().all(|&c| c > 0),
+        "{st:?}"
+    );
 }
 
 #[test]
@@ -205,7 +215,10 @@ fn mirror_pairs_with_centre_node() {
     }
     eprintln!("{st:?}");
     assert!(
-        st.degenerate >= 150 && st.centre_touchdowns >= 20 && st.bifurcations >= 10,
+        st.degenerate >= 150
+            && st.centre_touchdowns >= 20
+            && st.bifurcations >= 10
+            && st.chosen.iter().all(|&c| c > 0),
         "{st:?}"
     );
 }
