@@ -444,6 +444,7 @@ class Problem:
         branch: Optional[int] = None,
         basis=None,
         weights: Optional[Callable[[float], Any]] = None,
+        zero_tol: Optional[float] = None,
     ) -> Path:
         """Traces the solution path over ``window = (alpha_start, alpha_end)``.
 
@@ -485,6 +486,11 @@ class Problem:
         narrowest feature cannot miss it. No effect on an affine load (its pieces are
         followed exactly). ValueError when it is not finite or <= 0.
 
+        ``zero_tol`` (default 1e-11, in (0, 1e-3]): the relative tolerance for "a guard is
+        at zero" and "two nodes switch at once", relative to the local scales of each point
+        (the contact forces there, the terms of a displacement's own row), never to the
+        window. ValueError outside that range.
+
         The GIL is released while tracing (re-acquired only to call ``load``, ``dload`` or
         ``monitor``), so threads can trace different problems at once.
 
@@ -506,6 +512,8 @@ class Problem:
         a0 = None if alpha_start is None else float(alpha_start)
         ms = None if max_steps is None else int(max_steps)
         h = None if max_alpha_step is None else float(max_alpha_step)
+        zt = None if zero_tol is None else float(zero_tol)
+        opts = (win, a0, ms, h, zt)
         g = None if guess is None else _vector("guess", guess)
         if branch is not None and (
             isinstance(branch, bool) or not isinstance(branch, (int, np.integer)) or branch < 0
@@ -526,7 +534,7 @@ class Problem:
                 return _vector("weights phi", r[0]), _vector("weights dphi", r[1])
 
             try:
-                core = self._core.trace_basis(vectors, pair, win, a0, ms, h, monitor, g, b)
+                core = self._core.trace_basis(vectors, pair, opts, monitor, g, b)
             except Exception as err:  # noqa: BLE001
                 raise _reraise(err) from None
         elif load is not None:
@@ -541,10 +549,7 @@ class Problem:
                 real(load, "load"),
                 real(dload, "dload"),
                 int(n) if n is not None else self.n,
-                win,
-                a0,
-                ms,
-                h,
+                opts,
                 monitor,
                 g,
                 b,
@@ -554,7 +559,7 @@ class Problem:
                 raise ValueError("an affine load needs f0 and f1 (or give load=)")
             try:
                 core = self._core.trace_affine(
-                    _vector("f0", f0), _vector("f1", f1), win, a0, ms, h, monitor, g, b
+                    _vector("f0", f0), _vector("f1", f1), opts, monitor, g, b
                 )
             except Exception as err:  # noqa: BLE001
                 raise _reraise(err) from None

@@ -115,6 +115,7 @@ class Problem:
         branch: Optional[int] = None,
         basis: Optional[Sequence[npt.ArrayLike]] = None,
         weights: Optional[Callable[[float], Tuple[npt.ArrayLike, npt.ArrayLike]]] = None,
+        zero_tol: Optional[float] = None,
     ) -> Path: ...
 
 def read_case(directory: Any) -> dict[str, Any]: ...

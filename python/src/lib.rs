@@ -252,22 +252,19 @@ impl Problem {
 
     /// Traces an affine load f0 + α f1 (see `fricont.Problem.trace`).
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (f0, f1, window, alpha_start, max_steps, max_alpha_step, monitor, guess, branch))]
+    #[pyo3(signature = (f0, f1, opts, monitor, guess, branch))]
     fn trace_affine(
         &self,
         py: Python<'_>,
         f0: PyReadonlyArray1<'_, f64>,
         f1: PyReadonlyArray1<'_, f64>,
-        window: (f64, f64),
-        alpha_start: Option<f64>,
-        max_steps: Option<usize>,
-        max_alpha_step: Option<f64>,
+        opts: OptionArgs,
         monitor: Option<Py<PyAny>>,
         guess: Option<PyReadonlyArray1<'_, f64>>,
         branch: Option<usize>,
     ) -> PyResult<Path> {
         let load = Load::affine(f0.as_slice()?.to_vec(), f1.as_slice()?.to_vec()).map_err(to_py)?;
-        let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
+        let opts = options(opts)?;
         self.trace(py, load, opts, monitor, None, guess, branch)
     }
 
@@ -277,21 +274,18 @@ impl Problem {
     /// exception inside `weights` stops the path; it is kept on the path and re-raised by
     /// the Python layer.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (vectors, weights, window, alpha_start, max_steps, max_alpha_step, monitor, guess, branch))]
+    #[pyo3(signature = (vectors, weights, opts, monitor, guess, branch))]
     fn trace_basis(
         &self,
         py: Python<'_>,
         vectors: Vec<PyReadonlyArray1<'_, f64>>,
         weights: Py<PyAny>,
-        window: (f64, f64),
-        alpha_start: Option<f64>,
-        max_steps: Option<usize>,
-        max_alpha_step: Option<f64>,
+        opts: OptionArgs,
         monitor: Option<Py<PyAny>>,
         guess: Option<PyReadonlyArray1<'_, f64>>,
         branch: Option<usize>,
     ) -> PyResult<Path> {
-        let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
+        let opts = options(opts)?;
         let vectors = vectors
             .iter()
             .map(|v| v.as_slice().map(<[f64]>::to_vec))
@@ -326,22 +320,19 @@ impl Problem {
     /// derivative (central differences when None). An exception inside either stops the
     /// path; it is kept on the path and re-raised by the Python layer.
     #[allow(clippy::too_many_arguments)]
-    #[pyo3(signature = (load, dload, n, window, alpha_start, max_steps, max_alpha_step, monitor, guess, branch))]
+    #[pyo3(signature = (load, dload, n, opts, monitor, guess, branch))]
     fn trace_general(
         &self,
         py: Python<'_>,
         load: Py<PyAny>,
         dload: Option<Py<PyAny>>,
         n: usize,
-        window: (f64, f64),
-        alpha_start: Option<f64>,
-        max_steps: Option<usize>,
-        max_alpha_step: Option<f64>,
+        opts: OptionArgs,
         monitor: Option<Py<PyAny>>,
         guess: Option<PyReadonlyArray1<'_, f64>>,
         branch: Option<usize>,
     ) -> PyResult<Path> {
-        let opts = options(window, alpha_start, max_steps, max_alpha_step)?;
+        let opts = options(opts)?;
         let slot: Arc<Mutex<Option<PyErr>>> = Arc::new(Mutex::new(None));
         let wrap = |callable: Py<PyAny>, what: &'static str| {
             let slot = slot.clone();
@@ -395,15 +386,25 @@ fn copy_floats(
     Ok(())
 }
 
+/// The path options as `fricont.Problem.trace` passes them: the window, then
+/// alpha_start, max_steps, max_alpha_step and zero_tol (None: the defaults).
+type OptionArgs = (
+    (f64, f64),
+    Option<f64>,
+    Option<usize>,
+    Option<f64>,
+    Option<f64>,
+);
+
 /// The path options of `trace`: ValueError for `max_steps` = 0 (the other values are
 /// checked by `fricont::Path::new`).
 fn options(
-    window: (f64, f64),
-    alpha_start: Option<f64>,
-    max_steps: Option<usize>,
-    max_alpha_step: Option<f64>,
+    (window, alpha_start, max_steps, max_alpha_step, zero_tol): OptionArgs,
 ) -> PyResult<PathOptions> {
     let mut opts = PathOptions::window(window.0, window.1);
+    if let Some(z) = zero_tol {
+        opts.zero_tol = z;
+    }
     if let Some(a) = alpha_start {
         opts.alpha_start = a;
     }

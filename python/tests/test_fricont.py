@@ -584,3 +584,29 @@ def test_a_guess_that_solves_the_problem_starts_the_path_there():
     for bad, match in (([0.0], "2p"), ([0.0, float("nan")], "finite")):
         with pytest.raises(ValueError, match=match):
             prob.trace(f0, f1, window=(-1.0, 3.0), guess=bad)
+
+
+def test_zero_tol_decides_which_nearby_switches_are_one_transition_point():
+    # Two decoupled nodes (A = I, N = (u1, u3), T = (u2, u4), F = 1/2) pushed by
+    # f_n = alpha - 1/2 and alpha - 1/2 - d, sheared by +-0.1: by hand, node 1 closes at
+    # alpha = 1/2 (slip, since F |lambda_n| = (alpha - 1/2)/2 < 0.1) and sticks at 0.7,
+    # node 2 likewise d later. d = 1e-10 is above the default zero_tol (1e-11): four
+    # transition points; with zero_tol = 1e-9 the pairs are one point each.
+    A = sp.identity(4, format="csr")
+    prob = fricont.Problem(A, [[1, 0, 0, 0], [0, 0, 1, 0]], [[0, 1, 0, 0], [0, 0, 0, 1]],
+                           friction=0.5)
+    d = 1e-10
+    f0, f1 = [-0.5, 0.1, -0.5 - d, -0.1], [1.0, 0.0, 1.0, 0.0]
+    want = [(0.5, 0, "open", "slip+"), (0.5 + d, 1, "open", "slip-"),
+            (0.7, 0, "slip+", "stick"), (0.7 + d, 1, "slip-", "stick")]
+    apart = prob.trace(f0, f1, window=(0.0, 1.0))
+    assert [(e.node, e.from_class, e.to_class) for e in apart.events] == [w[1:] for w in want]
+    assert [e.transition for e in apart.events] == [0, 1, 2, 3]
+    assert all(abs(e.alpha - w[0]) <= 1e-14 for e, w in zip(apart.events, want))
+    together = prob.trace(f0, f1, window=(0.0, 1.0), zero_tol=1e-9)
+    assert [(e.node, e.from_class, e.to_class) for e in together.events] == [w[1:] for w in want]
+    assert [e.transition for e in together.events] == [0, 0, 1, 1]
+    assert all(abs(e.alpha - w[0]) <= 2 * d for e, w in zip(together.events, want))
+    for bad in (0.0, -1e-11, 1e-2, float("nan")):
+        with pytest.raises(ValueError, match="zero_tol"):
+            prob.trace(f0, f1, window=(0.0, 1.0), zero_tol=bad)
