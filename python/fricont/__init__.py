@@ -469,8 +469,9 @@ class Problem:
         forces. The contact problem at one alpha can have several solutions (large
         friction, a path that folds back over ``alpha_start``); the solve returns one of
         them, and which one can depend on rounding. A guess that solves the problem (to
-        1e-12 relative) is kept as it is: pass a known solution (``path.start``'s forces,
-        an event's, a :meth:`Path.solutions_at` state's) to trace from it. When several
+        1e-12 relative) is kept: the path starts from that solution. Pass a known one
+        (``path.start``'s forces, an event's, a :meth:`Path.solutions_at` state's) to
+        trace from it. When several
         pieces leave the start point toward ``window[1]`` (``path.start_branches``), the
         path takes the first, or ``branch`` (0-based) when given.
 

@@ -779,9 +779,9 @@ pub unsafe extern "C" fn fricont_path_set_monitor(
 ///
 /// The problem at one α can have several solutions (large friction, a path that folds
 /// back over `alpha`); the solver returns one of them, and which one can depend on
-/// rounding. A `guess` that already solves the problem (to 1e-12 relative) is kept as it
-/// is: pass a known solution (an event's or a `fricont_path_solutions_at` state's forces)
-/// to trace from exactly that one.
+/// rounding. A `guess` that already solves the problem (to 1e-12 relative) is kept: the
+/// path starts from that solution. Pass a known one (an event's or a
+/// `fricont_path_solutions_at` state's forces) to trace from it.
 ///
 /// * `alpha`: inside the window set by `fricont_path_set_window`.
 /// * `guess`: NULL, or 2p values: λν of nodes 0..p−1 then λt of nodes 0..p−1; copied.

@@ -1317,8 +1317,8 @@ impl Path {
     /// (`(λν, λt)`, 2p values) or from zero forces. Clears events and pieces.
     /// The problem at one α can have several solutions (large friction, a path that folds
     /// back over `alpha`); the solver returns one, and which one can depend on rounding. A
-    /// `guess` that already solves the problem (to 1e-12 relative) is kept as it is: pass a
-    /// known solution to trace from exactly that one.
+    /// `guess` that already solves the problem (to 1e-12 relative) is kept: the path starts
+    /// from that solution. Pass a known one to trace from it.
     /// When several pieces leave the start point toward `alpha_end`, the path takes the
     /// first and [`Path::branches`] lists them all (see [`Path::choose_branch`]). When the
     /// start lies on a vertical piece (a continuum at this α), the path follows the way
