@@ -251,8 +251,8 @@ pub struct Path {
     /// transition point needs the point's, and the ratio test on the piece taken needs
     /// that of the piece's own point (primed when it was solved for).
     gaps_cache: PointCache<Arc<Vec<f64>>>,
-    /// The last point's "at zero" thresholds with its (α, λ).
-    tol_cache: RefCell<Option<(f64, Vec<f64>, Tol)>>,
+    /// The last few points' "at zero" thresholds with their (α, λ).
+    tol_cache: PointCache<Tol>,
     /// The last few force scales with their (α, λ): a transition reads those of its point
     /// and of the point it came from several times, each an O(m) scan.
     scale_cache: PointCache<f64>,
@@ -698,7 +698,7 @@ impl Path {
             updater: RefCell::new(None),
             refactorisations: Cell::new(0),
             gaps_cache: PointCache::new(),
-            tol_cache: RefCell::new(None),
+            tol_cache: PointCache::new(),
             scale_cache: PointCache::new(),
             graph_step: Cell::new(None),
         })
@@ -790,11 +790,8 @@ impl Path {
     /// forces, `max(‖λ‖∞, force scale / 10)` (the floor keeps the rounding of λ, which is
     /// relative to the load, below it where all forces vanish together).
     fn tol_at(&self, pt: &Point) -> Tol {
-        if let Some((a, lam, t)) = &*self.tol_cache.borrow()
-            && *a == pt.alpha
-            && *lam == pt.lam
-        {
-            return t.clone();
+        if let Some(t) = self.tol_cache.get(pt.alpha, &pt.lam) {
+            return t;
         }
         // The rows of q come from solves with A, whose rounding is relative to the whole
         // vector: no row's threshold goes below 1e-3 of the point's.
@@ -827,7 +824,7 @@ impl Path {
             arc: z,
             rounding: ROUNDING,
         };
-        *self.tol_cache.borrow_mut() = Some((pt.alpha, pt.lam.clone(), tol.clone()));
+        self.tol_cache.put(pt.alpha, &pt.lam, tol.clone());
         tol
     }
 
