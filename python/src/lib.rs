@@ -294,13 +294,7 @@ impl Problem {
         let keep = slot.clone();
         let w = Box::new(move |alpha: f64, phi: &mut [f64], dphi: &mut [f64]| {
             Python::attach(|py| -> Result<(), LoadFailure> {
-                let fail = |e: PyErr| {
-                    let message = format!("weights raised {e}");
-                    if let Ok(mut s) = keep.lock() {
-                        s.get_or_insert(e);
-                    }
-                    LoadFailure { code: 1, message }
-                };
+                let fail = |e: PyErr| keep_error(&keep, "weights", e);
                 let v = weights.call1(py, (alpha,)).map_err(fail)?;
                 let (p, d): (Bound<'_, PyAny>, Bound<'_, PyAny>) =
                     v.bind(py).extract().map_err(|e: PyErr| {
@@ -338,13 +332,7 @@ impl Problem {
             let slot = slot.clone();
             Box::new(move |alpha: f64, out: &mut [f64]| {
                 Python::attach(|py| -> Result<(), LoadFailure> {
-                    let fail = |e: PyErr| {
-                        let message = format!("{what} raised {e}");
-                        if let Ok(mut s) = slot.lock() {
-                            s.get_or_insert(e);
-                        }
-                        LoadFailure { code: 1, message }
-                    };
+                    let fail = |e: PyErr| keep_error(&slot, what, e);
                     let v = callable.call1(py, (alpha,)).map_err(fail)?;
                     copy_floats(py, v.bind(py), out, what, "n").map_err(fail)
                 })
@@ -355,6 +343,16 @@ impl Problem {
         let load = Load::general(n, f, df);
         self.trace(py, load, opts, monitor, Some(slot), guess, branch)
     }
+}
+
+/// A Python load callable (`what`) raised `e`: `e` is kept in `slot` (the first one, for
+/// the Python layer to re-raise) and the library gets a failure that names it.
+fn keep_error(slot: &Mutex<Option<PyErr>>, what: &str, e: PyErr) -> LoadFailure {
+    let message = format!("{what} raised {e}");
+    if let Ok(mut s) = slot.lock() {
+        s.get_or_insert(e);
+    }
+    LoadFailure { code: 1, message }
 }
 
 /// Copies `v` (anything numpy reads as a 1-D float64 array) into `out`: ValueError when
