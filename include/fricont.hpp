@@ -239,10 +239,10 @@ struct LoadContext {
     std::function<void(double, double *, double *, std::size_t)> w;
 };
 
-inline int32_t call_load(const std::function<void(double, double *, std::size_t)> &fn,
-                         LoadContext *ctx, double alpha, double *out, int64_t n) noexcept {
+/// Runs a load or weights callable: 0, or 1 with its exception kept in `ctx`.
+template <class Call> int32_t guarded(LoadContext *ctx, Call &&call) noexcept {
     try {
-        fn(alpha, out, static_cast<std::size_t>(n));
+        call();
         return 0;
     } catch (...) {
         // Never let an exception reach the library: keep it and return a code.
@@ -254,26 +254,19 @@ inline int32_t call_load(const std::function<void(double, double *, std::size_t)
 extern "C" inline int32_t fricont_cxx_load_trampoline(double alpha, double *out, int64_t n,
                                                       void *ud) {
     auto *ctx = static_cast<LoadContext *>(ud);
-    return call_load(ctx->f, ctx, alpha, out, n);
+    return guarded(ctx, [&] { ctx->f(alpha, out, static_cast<std::size_t>(n)); });
 }
 
 extern "C" inline int32_t fricont_cxx_dload_trampoline(double alpha, double *out, int64_t n,
                                                        void *ud) {
     auto *ctx = static_cast<LoadContext *>(ud);
-    return call_load(ctx->df, ctx, alpha, out, n);
+    return guarded(ctx, [&] { ctx->df(alpha, out, static_cast<std::size_t>(n)); });
 }
 
 extern "C" inline int32_t fricont_cxx_weights_trampoline(double alpha, double *phi,
                                                          double *dphi, int64_t k, void *ud) {
     auto *ctx = static_cast<LoadContext *>(ud);
-    try {
-        ctx->w(alpha, phi, dphi, static_cast<std::size_t>(k));
-        return 0;
-    } catch (...) {
-        // Never let an exception reach the library: keep it and return a code.
-        if (!ctx->pending) ctx->pending = std::current_exception();
-        return 1;
-    }
+    return guarded(ctx, [&] { ctx->w(alpha, phi, dphi, static_cast<std::size_t>(k)); });
 }
 
 extern "C" inline void fricont_cxx_free_context(void *ud) {
