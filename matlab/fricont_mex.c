@@ -735,49 +735,54 @@ static void cmd_problem_set(int nrhs, const mxArray *prhs[], const char *cmd) {
     }
 }
 
+enum { PATH_AFFINE, PATH_GENERAL, PATH_BASIS };
+
 /* ('path_new_affine', prob, f0, f1), ('path_new_general', prob, has_derivative) or
  * ('path_new_basis', prob, V): V n-by-k, the vectors of a basis load whose weights
- * MATLAB returns as [phi; phi'] (request 'w'). */
+ * MATLAB returns as [phi; phi'] (request 'w'). A path with a MATLAB function gets a
+ * worker thread. */
 static void cmd_path_new(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[],
-                         const char *cmd, int general) {
+                         const char *cmd, int kind) {
     (void)nlhs;
-    NEED(general ? 3 : 4);
+    NEED(kind == PATH_AFFINE ? 4 : 3);
     entry *pe = lookup(prhs[1], KIND_PROBLEM);
     fricont_path *path = NULL;
     worker *w = NULL;
-    if (general == 2) {
-        const mxArray *v = prhs[2];
-        if (!mxIsDouble(v) || mxIsComplex(v) || mxIsSparse(v) ||
-            (int64_t)mxGetM(v) != pe->n || mxGetN(v) < 1)
-            mexErrMsgIdAndTxt("fricont:argument",
-                              "fricont: the basis vectors must be a real dense n-by-k matrix "
-                              "(n = %lld rows, k >= 1 columns)",
-                              (long long)pe->n);
-        int64_t k = (int64_t)mxGetN(v);
-        w = worker_new(NULL);
-        if (!w) mexErrMsgIdAndTxt("fricont:thread", "fricont: cannot start a worker thread");
-        w->weights_buf = (double *)calloc((size_t)(2 * k), sizeof(double));
-        if (!w->weights_buf) {
-            worker_stop(w);
-            mexErrMsgIdAndTxt("fricont:memory", "fricont: out of memory");
-        }
-        int32_t st =
-            fricont_path_new_basis(pe->problem, mxGetPr(v), pe->n, k, weights_cb, w, NULL, &path);
-        if (st < 0) {
-            worker_stop(w);
-            raise_status(st, "path");
-        }
-        w->path = path;
-    } else if (!general) {
+    if (kind == PATH_AFFINE) {
         const double *f0 = get_vector(prhs[2], pe->n, "f0");
         const double *f1 = get_vector(prhs[3], pe->n, "f1");
         check(fricont_path_new_affine(pe->problem, f0, f1, pe->n, &path), "path");
     } else {
-        int with_derivative = get_scalar(prhs[2], "has_derivative") != 0;
+        /* the arguments checked before the worker exists: an error leaves nothing behind */
+        const mxArray *v = prhs[2];
+        int64_t k = 0;
+        int with_derivative = 0;
+        if (kind == PATH_BASIS) {
+            if (!mxIsDouble(v) || mxIsComplex(v) || mxIsSparse(v) ||
+                (int64_t)mxGetM(v) != pe->n || mxGetN(v) < 1)
+                mexErrMsgIdAndTxt("fricont:argument",
+                                  "fricont: the basis vectors must be a real dense n-by-k "
+                                  "matrix (n = %lld rows, k >= 1 columns)",
+                                  (long long)pe->n);
+            k = (int64_t)mxGetN(v);
+        } else {
+            with_derivative = get_scalar(v, "has_derivative") != 0;
+        }
         w = worker_new(NULL);
         if (!w) mexErrMsgIdAndTxt("fricont:thread", "fricont: cannot start a worker thread");
-        int32_t st = fricont_path_new_general(pe->problem, pe->n, load_cb,
-                                              with_derivative ? dload_cb : NULL, w, NULL, &path);
+        int32_t st;
+        if (kind == PATH_BASIS) {
+            w->weights_buf = (double *)calloc((size_t)(2 * k), sizeof(double));
+            if (!w->weights_buf) {
+                worker_stop(w);
+                mexErrMsgIdAndTxt("fricont:memory", "fricont: out of memory");
+            }
+            st = fricont_path_new_basis(pe->problem, mxGetPr(v), pe->n, k, weights_cb, w, NULL,
+                                        &path);
+        } else {
+            st = fricont_path_new_general(pe->problem, pe->n, load_cb,
+                                          with_derivative ? dload_cb : NULL, w, NULL, &path);
+        }
         if (st < 0) {
             worker_stop(w);
             raise_status(st, "path");
@@ -977,11 +982,11 @@ void mexFunction(int nlhs, mxArray *plhs[], int nrhs, const mxArray *prhs[]) {
         plhs[0] = logical(ext);
         if (nlhs > 1) plhs[1] = mxCreateDoubleScalar(kappa);
     } else if (strcmp(cmd, "path_new_affine") == 0) {
-        cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, 0);
+        cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, PATH_AFFINE);
     } else if (strcmp(cmd, "path_new_basis") == 0) {
-        cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, 2);
+        cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, PATH_BASIS);
     } else if (strcmp(cmd, "path_new_general") == 0) {
-        cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, 1);
+        cmd_path_new(nlhs, plhs, nrhs, prhs, cmd, PATH_GENERAL);
     } else if (strcmp(cmd, "path_set") == 0) {
         cmd_path_set(nrhs, prhs, cmd);
     } else if (strcmp(cmd, "path_call") == 0) {
