@@ -436,3 +436,151 @@ fn per_node_row_scalings_at_extreme_sizes() {
         assert_prefix(&ctx, base.events(), path.events(), 1e-10);
     }
 }
+
+/// The load of the reversal test: affine, or the basis load `f0 + φ(α) f1` with
+/// `φ = α + 0.3 sin 5α` (not monotone: dφ/dα = 1 + 1.5 cos 5α changes sign).
+fn reversal_load(data: &Data, oscillating: bool) -> fricont::Load {
+    if !oscillating {
+        return data.affine_load();
+    }
+    let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
+    fricont::Load::basis(
+        vec![f0, f1],
+        Box::new(|a: f64, w: &mut [f64], dw: &mut [f64]| {
+            w[0] = 1.0;
+            w[1] = a + 0.3 * (5.0 * a).sin();
+            dw[0] = 0.0;
+            dw[1] = 1.0 + 1.5 * (5.0 * a).cos();
+            Ok::<(), fricont::load::LoadFailure>(())
+        }),
+    )
+    .unwrap()
+}
+
+/// Traces `case` forward, then backward from its end state (given as the guess, which is
+/// kept) to the start of the window. `false` where the forward path does not end at the
+/// window's far end (it folds back out through the start) or meets a bifurcation, where
+/// the way back is not the same curve; else asserts that the way back is the same curve:
+/// the same transition points in reverse order (α to 1e-10 relative to max(1, |α|)),
+/// each node's change reversed, the same folds, and that it ends at the forward start's
+/// state.
+fn reversal_holds(ctx: &str, case: &common::Case, oscillating: bool) -> bool {
+    let problem = Arc::new(case.data.problem());
+    let fwd = trace(
+        problem.clone(),
+        reversal_load(&case.data, oscillating),
+        case.a0,
+        case.a1,
+    );
+    let mut fwd = fwd;
+    let end = fwd.current().unwrap();
+    if end.alpha != case.a1 || fwd.events().iter().any(|e| e.bifurcation) {
+        return false;
+    }
+    let guess: Vec<f64> = end.lambda_n.iter().chain(&end.lambda_t).copied().collect();
+    let opts = fricont::PathOptions::window(case.a1, case.a0);
+    let mut back = Path::new(problem, reversal_load(&case.data, oscillating), opts).unwrap();
+    back.start(case.a1, Some(&guess)).unwrap();
+    back.run().unwrap();
+    assert_eq!(
+        back.end_reason(),
+        Some(&fricont::EndReason::Window),
+        "{ctx}"
+    );
+    // One entry per transition point: α, fold, and its node changes sorted by node.
+    let points = |ev: &[Event], reversed: bool| {
+        let mut g: Vec<(f64, bool, Vec<NodeChange>)> = Vec::new();
+        for e in ev {
+            if g.len() == e.transition {
+                g.push((e.alpha, false, Vec::new()));
+            }
+            let t = g.last_mut().unwrap();
+            t.1 |= e.fold;
+            t.2.push(if reversed {
+                (e.node, e.to, e.from)
+            } else {
+                (e.node, e.from, e.to)
+            });
+        }
+        for t in &mut g {
+            t.2.sort_by_key(|k| k.0);
+        }
+        g
+    };
+    let there = points(fwd.events(), false);
+    let mut back_pts = points(back.events(), true);
+    back_pts.reverse();
+    assert_eq!(there.len(), back_pts.len(), "{ctx}: transition points");
+    for (k, (x, y)) in there.iter().zip(&back_pts).enumerate() {
+        assert!(
+            close(x.0, y.0, 1e-10),
+            "{ctx}: transition {} at α {:.17e}, on the way back {:.17e}",
+            k + 1,
+            x.0,
+            y.0
+        );
+        assert_eq!((x.1, &x.2), (y.1, &y.2), "{ctx}: transition {}", k + 1);
+    }
+    let (s0, s1) = (fwd.start_state().unwrap(), back.current().unwrap());
+    assert_eq!(s1.classes, s0.classes, "{ctx}: end of the way back");
+    let (l0, l1) = (common::lambda_of(&s0), common::lambda_of(&s1));
+    let scale = l0.amax().max(f64::MIN_POSITIVE);
+    for (a, b) in l0.iter().zip(l1.iter()) {
+        assert!(
+            (a - b).abs() <= 1e-9 * scale,
+            "{ctx}: λ {b:e} back at the start, {a:e} there"
+        );
+    }
+    true
+}
+
+/// Path reversal: traced from the end state of a forward trace back to the window's
+/// start, the path is the same curve (same transition points in reverse, each change
+/// reversed, the same folds) and ends at the forward start's state. Checks that nothing
+/// in the ratio test, the joins or the orientation depends on the direction of travel;
+/// affine and oscillating (non-monotone basis) loads on random, large-friction,
+/// mirror-symmetric and finite-element problems.
+#[test]
+fn path_reversal() {
+    let mut families: Vec<(&str, Vec<common::Case>)> = vec![
+        ("random", (0..60).map(random_case).collect()),
+        (
+            "large friction",
+            (0..60).map(common::large_friction_case).collect(),
+        ),
+        (
+            "symmetric",
+            (0..40)
+                .map(|s| common::symmetric_case(s, s % 2 == 0))
+                .collect(),
+        ),
+    ];
+    families.push((
+        "mesh",
+        (0..24)
+            .map(|s| {
+                common::fe_case(
+                    s,
+                    4 + (s % 13) as usize * 5,
+                    1 + (s % 4) as usize,
+                    [0.1, 0.8, 3.0, 5.0][(s % 4) as usize],
+                )
+            })
+            .collect(),
+    ));
+    for (name, cases) in &families {
+        for oscillating in [false, true] {
+            let mut traced = 0;
+            for case in cases {
+                let ctx = format!("{name} seed {}, oscillating {oscillating}", case.seed);
+                traced += usize::from(reversal_holds(&ctx, case, oscillating));
+            }
+            // Most paths end at the far end without a bifurcation (else the test is empty).
+            assert!(
+                4 * traced >= 3 * cases.len(),
+                "{name}: {traced} of {} traced",
+                cases.len()
+            );
+        }
+    }
+}
