@@ -576,9 +576,12 @@ impl Delassus {
             .z
             .as_ref()
             .expect("condense_half needs the trailing block");
-        let first = self.n - z.nrows();
+        let ys = &y[self.n - z.nrows()..];
         (0..z.ncols())
-            .map(|i| (0..z.nrows()).map(|r| z[(r, i)] * y[first + r]).sum())
+            .map(|i| {
+                let col = z.col(i).try_as_col_major().expect("contiguous");
+                crate::dense::dot(col.as_slice(), ys)
+            })
             .collect()
     }
 
