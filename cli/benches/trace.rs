@@ -6,6 +6,7 @@
 //! FRICONT_BENCH_CASE=DIR FRICONT_BENCH_REPS=15 cargo bench --bench trace
 //! FRICONT_BENCH_LOAD=basis-sine cargo bench --bench trace -- DIR
 //! FRICONT_BENCH_THREADS=2 cargo bench --bench trace -- DIR
+//! FRICONT_BENCH_LOAD=general-sine FRICONT_BENCH_AMP=0.05 cargo bench --bench trace -- DIR
 //! ```
 //!
 //! `FRICONT_BENCH_THREADS` (default 1) is the problem's `threads`: the set-up's, and the
@@ -13,7 +14,9 @@
 //!
 //! `FRICONT_BENCH_LOAD` chooses the load: `affine` (default: the directory's f0 + α f1),
 //! or the oscillating `f0 + φ(α) f1`, `φ(α) = α + A sin(2π·10 (α − α_start)/L)` with
-//! L the window's length and A = L/100 (ten periods over the window), given as a basis
+//! L the window's length and A = L/100 (ten periods over the window; `FRICONT_BENCH_AMP=a`
+//! sets A = a L: from a = 1/(20π) ≈ 0.016 on, φ is not monotone and every guard turns
+//! where φ does), given as a basis
 //! load (`basis-sine`: vectors f0, f1 and the weights) or as a general load
 //! (`general-sine`: f itself, condensed at every α).
 //!
@@ -70,7 +73,11 @@ fn main() {
     let opts = PathOptions::window(case.alpha_start, case.alpha_end);
     let kind = std::env::var("FRICONT_BENCH_LOAD").unwrap_or_else(|_| "affine".into());
     let (a_start, len) = (case.alpha_start, case.alpha_end - case.alpha_start);
-    let (amp, omega) = (len / 100.0, 2.0 * std::f64::consts::PI * 10.0 / len);
+    let amp_frac: f64 = std::env::var("FRICONT_BENCH_AMP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.01);
+    let (amp, omega) = (amp_frac * len, 2.0 * std::f64::consts::PI * 10.0 / len);
     let load = || -> Load {
         let (f0, f1) = (case.f0.clone(), case.f1.clone());
         match kind.as_str() {
