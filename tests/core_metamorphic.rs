@@ -461,9 +461,9 @@ fn reversal_load(data: &Data, oscillating: bool) -> fricont::Load {
 /// kept) to the start of the window. `false` where the forward path does not end at the
 /// window's far end (it folds back out through the start) or meets a bifurcation, where
 /// the way back is not the same curve; else asserts that the way back is the same curve:
-/// the same transition points in reverse order (α to 1e-10 relative to max(1, |α|)),
-/// each node's change reversed, the same folds, and that it ends at the forward start's
-/// state.
+/// the same transition points in reverse order (α to 1e-10 relative to max(1, |α|), the
+/// contact forces there to 1e-9 of the largest), each node's change reversed, the same
+/// folds, and that it ends at the forward start's state.
 fn reversal_holds(ctx: &str, case: &common::Case, oscillating: bool) -> bool {
     let problem = Arc::new(case.data.problem());
     let fwd = trace(
@@ -487,12 +487,14 @@ fn reversal_holds(ctx: &str, case: &common::Case, oscillating: bool) -> bool {
         Some(&fricont::EndReason::Window),
         "{ctx}"
     );
-    // One entry per transition point: α, fold, and its node changes sorted by node.
+    // One entry per transition point: α, fold, node changes, (λν, λt) there.
+    type Point = (f64, bool, Vec<NodeChange>, Vec<f64>);
     let points = |ev: &[Event], reversed: bool| {
-        let mut g: Vec<(f64, bool, Vec<NodeChange>)> = Vec::new();
+        let mut g: Vec<Point> = Vec::new();
         for e in ev {
             if g.len() == e.transition {
-                g.push((e.alpha, false, Vec::new()));
+                let lam = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
+                g.push((e.alpha, false, Vec::new(), lam));
             }
             let t = g.last_mut().unwrap();
             t.1 |= e.fold;
@@ -520,6 +522,14 @@ fn reversal_holds(ctx: &str, case: &common::Case, oscillating: bool) -> bool {
             y.0
         );
         assert_eq!((x.1, &x.2), (y.1, &y.2), "{ctx}: transition {}", k + 1);
+        let scale = x.3.iter().fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
+        for (a, b) in x.3.iter().zip(&y.3) {
+            assert!(
+                (a - b).abs() <= 1e-9 * scale,
+                "{ctx}: transition {}: λ {b:e} on the way back, {a:e} there",
+                k + 1
+            );
+        }
     }
     let (s0, s1) = (fwd.start_state().unwrap(), back.current().unwrap());
     assert_eq!(s1.classes, s0.classes, "{ctx}: end of the way back");
