@@ -53,6 +53,39 @@ fn assert_prefix(ctx: &str, base: &[Event], other: &[Event], tol: f64) {
     }
 }
 
+/// One transition point of a path: its α, whether the path folds there, its node changes
+/// as `change` gives them (sorted by node: the events of one transition are listed in
+/// node order, which a permutation changes) and the contact forces `(λν, λt)` there.
+struct TransitionPoint {
+    transition: usize,
+    alpha: f64,
+    fold: bool,
+    changes: Vec<NodeChange>,
+    lambda: Vec<f64>,
+}
+
+fn transition_points(ev: &[Event], change: impl Fn(&Event) -> NodeChange) -> Vec<TransitionPoint> {
+    let mut g: Vec<TransitionPoint> = Vec::new();
+    for e in ev {
+        if g.last().is_none_or(|t| t.transition != e.transition) {
+            g.push(TransitionPoint {
+                transition: e.transition,
+                alpha: e.alpha,
+                fold: false,
+                changes: Vec::new(),
+                lambda: e.lambda_n.iter().chain(&e.lambda_t).copied().collect(),
+            });
+        }
+        let t = g.last_mut().unwrap();
+        t.fold |= e.fold;
+        t.changes.push(change(e));
+    }
+    for t in &mut g {
+        t.changes.sort_by_key(|k| k.0);
+    }
+    g
+}
+
 fn start_classes(p: &Path) -> Vec<fricont::Class> {
     p.start_state().expect("started").classes.clone()
 }
@@ -183,25 +216,16 @@ fn node_permutations() {
         let ctx = format!("seed {seed}, permutation {perm:?}");
         let (x, y) = (base.events(), path.events());
         assert_eq!(x.len(), y.len(), "{ctx}");
-        // Events of one transition are listed in node order: compare them as sets.
-        let group = |ev: &[Event], map: &dyn Fn(usize) -> usize| {
-            let mut g: Vec<(usize, f64, Vec<NodeChange>)> = Vec::new();
-            for e in ev {
-                if g.last().is_none_or(|l| l.0 != e.transition) {
-                    g.push((e.transition, e.alpha, Vec::new()));
-                }
-                g.last_mut().unwrap().2.push((map(e.node), e.from, e.to));
-            }
-            for t in &mut g {
-                t.2.sort_by_key(|k| k.0);
-            }
-            g
-        };
-        let gx = group(x, &|i| perm[i]);
-        let gy = group(y, &|i| i);
+        let gx = transition_points(x, |e| (perm[e.node], e.from, e.to));
+        let gy = transition_points(y, |e| (e.node, e.from, e.to));
         for (a, b) in gx.iter().zip(&gy) {
-            assert!(close(a.1, b.1, 1e-11), "{ctx}: α {} vs {}", a.1, b.1);
-            assert_eq!(a.2, b.2, "{ctx}");
+            assert!(
+                close(a.alpha, b.alpha, 1e-11),
+                "{ctx}: α {} vs {}",
+                a.alpha,
+                b.alpha
+            );
+            assert_eq!(a.changes, b.changes, "{ctx}");
         }
     }
 }
@@ -487,43 +511,29 @@ fn reversal_holds(ctx: &str, case: &common::Case, oscillating: bool) -> bool {
         Some(&fricont::EndReason::Window),
         "{ctx}"
     );
-    // One entry per transition point: α, fold, node changes, (λν, λt) there.
-    type Point = (f64, bool, Vec<NodeChange>, Vec<f64>);
-    let points = |ev: &[Event], reversed: bool| {
-        let mut g: Vec<Point> = Vec::new();
-        for e in ev {
-            if g.len() == e.transition {
-                let lam = e.lambda_n.iter().chain(&e.lambda_t).copied().collect();
-                g.push((e.alpha, false, Vec::new(), lam));
-            }
-            let t = g.last_mut().unwrap();
-            t.1 |= e.fold;
-            t.2.push(if reversed {
-                (e.node, e.to, e.from)
-            } else {
-                (e.node, e.from, e.to)
-            });
-        }
-        for t in &mut g {
-            t.2.sort_by_key(|k| k.0);
-        }
-        g
-    };
-    let there = points(fwd.events(), false);
-    let mut back_pts = points(back.events(), true);
+    let there = transition_points(fwd.events(), |e| (e.node, e.from, e.to));
+    let mut back_pts = transition_points(back.events(), |e| (e.node, e.to, e.from));
     back_pts.reverse();
     assert_eq!(there.len(), back_pts.len(), "{ctx}: transition points");
     for (k, (x, y)) in there.iter().zip(&back_pts).enumerate() {
         assert!(
-            close(x.0, y.0, 1e-10),
+            close(x.alpha, y.alpha, 1e-10),
             "{ctx}: transition {} at α {:.17e}, on the way back {:.17e}",
             k + 1,
-            x.0,
-            y.0
+            x.alpha,
+            y.alpha
         );
-        assert_eq!((x.1, &x.2), (y.1, &y.2), "{ctx}: transition {}", k + 1);
-        let scale = x.3.iter().fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
-        for (a, b) in x.3.iter().zip(&y.3) {
+        assert_eq!(
+            (x.fold, &x.changes),
+            (y.fold, &y.changes),
+            "{ctx}: transition {}",
+            k + 1
+        );
+        let scale = x
+            .lambda
+            .iter()
+            .fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
+        for (a, b) in x.lambda.iter().zip(&y.lambda) {
             assert!(
                 (a - b).abs() <= 1e-9 * scale,
                 "{ctx}: transition {}: λ {b:e} on the way back, {a:e} there",
