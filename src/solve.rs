@@ -35,7 +35,7 @@ fn frozen_class(frozen: Frozen<'_>, i: usize) -> Option<Class> {
     frozen.and_then(|f| f[i])
 }
 
-/// `H2, H3` of the seed (2p values) at `λ`, and the force scale of each node (p values)
+/// `H2, H3` of the seed (2p values) at `λ` (with its `d = q − (g, 0) + W λ`), and the force scale of each node (p values)
 /// that makes its two entries relative: the magnitudes of the node's own terms (`λ_i`,
 /// `r d_i`, `r (q − g)_i`, `r (W λ)_i`), but not below a thousandth of the point's force
 /// scale (forces, `r W λ`, and `r q` where the load alone presses or shears). A node far
@@ -44,13 +44,12 @@ fn frozen_class(frozen: Frozen<'_>, i: usize) -> Option<Class> {
 /// class's equations instead.
 fn h_condensed(
     c: &PieceConstants,
-    w: MatRef<'_, f64>,
     qg: &[f64],
     lam: &[f64],
+    d: &[f64],
     frozen: Frozen<'_>,
 ) -> (Vec<f64>, Vec<f64>) {
     let p = c.p;
-    let d = displacement_gaps(w, qg, lam);
     let mut h = vec![0.0; 2 * p];
     let mut own = vec![0.0f64; p];
     let mut global = 1e-300f64;
@@ -58,8 +57,8 @@ fn h_condensed(
         let (ln, lt) = (lam[i], lam[p + i]);
         if let Some(cl) = frozen_class(frozen, i) {
             let [e_nu, e_t] = c.equations(i, cl);
-            h[i] = e_nu.eval(lam, &d);
-            h[p + i] = e_t.eval(lam, &d);
+            h[i] = e_nu.eval(lam, d);
+            h[p + i] = e_t.eval(lam, d);
         } else {
             h[i] = ln - (ln - c.r * d[i]).min(0.0);
             let b = (-c.friction[i] * ln).max(0.0);
@@ -88,14 +87,8 @@ fn h_condensed(
 }
 
 /// `max_i max(|H2_i|, |H3_i|) / scale_i` (see [`h_condensed`]).
-fn rel_residual(
-    c: &PieceConstants,
-    w: MatRef<'_, f64>,
-    qg: &[f64],
-    lam: &[f64],
-    fr: Frozen<'_>,
-) -> f64 {
-    let (h, s) = h_condensed(c, w, qg, lam, fr);
+fn rel_residual(c: &PieceConstants, qg: &[f64], lam: &[f64], d: &[f64], fr: Frozen<'_>) -> f64 {
+    let (h, s) = h_condensed(c, qg, lam, d, fr);
     if h.iter().any(|v| !v.is_finite()) {
         return f64::INFINITY;
     }
@@ -103,21 +96,20 @@ fn rel_residual(
     (0..p).fold(0.0f64, |m, i| m.max(h[i].abs().max(h[p + i].abs()) / s[i]))
 }
 
-fn merit(c: &PieceConstants, w: MatRef<'_, f64>, qg: &[f64], lam: &[f64], fr: Frozen<'_>) -> f64 {
-    let (h, _) = h_condensed(c, w, qg, lam, fr);
+fn merit(c: &PieceConstants, qg: &[f64], lam: &[f64], d: &[f64], fr: Frozen<'_>) -> f64 {
+    let (h, _) = h_condensed(c, qg, lam, d, fr);
     0.5 * h.iter().map(|v| v * v).sum::<f64>()
 }
 
-/// The classes of the generalized Jacobian at `λ` (projection arguments).
+/// The classes of the generalized Jacobian at `λ` (projection arguments), from λ and its
+/// `d = q − (g, 0) + W λ` ([`displacement_gaps`]).
 pub(crate) fn active_classes(
     c: &PieceConstants,
-    w: MatRef<'_, f64>,
-    qg: &[f64],
     lam: &[f64],
+    d: &[f64],
     fr: Frozen<'_>,
 ) -> Vec<Class> {
     let p = c.p;
-    let d = displacement_gaps(w, qg, lam);
     (0..p)
         .map(|i| {
             if let Some(cl) = frozen_class(fr, i) {
@@ -185,8 +177,13 @@ impl<'a> PieceSolves<'a> {
         }
     }
 
-    /// As [`solve_piece`].
-    fn solve(&mut self, classes: &[Class], qg: &[f64]) -> Option<Vec<f64>> {
+    /// As [`solve_piece`], with the solution's `d = q − (g, 0) + W λ` (from the product
+    /// that checked the solve).
+    fn solve(&mut self, classes: &[Class], qg: &[f64]) -> Option<(Vec<f64>, Vec<f64>)> {
+        let with_d = |x: Vec<f64>, wx: Vec<f64>| {
+            let d: Vec<f64> = qg.iter().zip(&wx).map(|(a, b)| a + b).collect();
+            (x.iter().chain(&d).all(|v| v.is_finite())).then_some((x, d))
+        };
         let rhs = self.c.piece_rhs(classes, qg);
         let extended = self
             .lu
@@ -195,11 +192,13 @@ impl<'a> PieceSolves<'a> {
             .and_then(|u| u.extend(self.c, self.w, classes, None, &[]))
             .map(|(u, _)| u);
         if let Some(u) = extended {
-            let crate::path::update::Checked { x, rel, .. } =
+            let crate::path::update::Checked { x, rel, wx, .. } =
                 u.solve_checked(self.c, self.w, &rhs, self.row_bound);
-            if rel <= 1e-12 && x.iter().all(|v| v.is_finite()) {
+            if rel <= 1e-12
+                && let Some(xd) = with_d(x, wx)
+            {
                 self.lu = Some(u);
-                return Some(x);
+                return Some(xd);
             }
         }
         // A fresh factorisation, with the singularity test of solve_piece.
@@ -207,9 +206,9 @@ impl<'a> PieceSolves<'a> {
         if u.pivot_ratio() < 1e-14 {
             return None;
         }
-        let x = u.solve_checked(self.c, self.w, &rhs, self.row_bound).x;
+        let checked = u.solve_checked(self.c, self.w, &rhs, self.row_bound);
         self.lu = Some(u);
-        x.iter().all(|v| v.is_finite()).then_some(x)
+        with_d(checked.x, checked.wx)
     }
 }
 
@@ -224,39 +223,59 @@ fn newton(
 ) -> (Vec<f64>, bool, String) {
     let (c, w) = (pieces.c, pieces.w);
     let mut lam = lam0;
-    let mut phi = merit(c, w, qg, &lam, fr);
+    // d = q − (g, 0) + W λ of the iterate: one product with W per iteration (W is 8m²
+    // bytes, so on a large contact boundary these products, not the O(m²) updated solves,
+    // were most of the solver's time when each function below made its own).
+    let mut d = displacement_gaps(w, qg, &lam);
+    let mut phi = merit(c, qg, &lam, &d, fr);
     // Consecutive Newton steps usually change the classes of a few nodes: their piece
     // matrices are solved by rank-2 updates of one factorisation (O(m²) each), with a
     // fresh factorisation when many nodes changed or an update loses accuracy.
     for it in 0..max_iter {
-        if rel_residual(c, w, qg, &lam, fr) <= TOL {
+        if rel_residual(c, qg, &lam, &d, fr) <= TOL {
             return (lam, true, format!("Newton converged in {it} iterations"));
         }
-        let classes = active_classes(c, w, qg, &lam, fr);
+        let classes = active_classes(c, &lam, &d, fr);
 
-        let Some(ln) = pieces.solve(&classes, qg) else {
+        let Some((ln, dn)) = pieces.solve(&classes, qg) else {
             return (
                 lam,
                 false,
                 format!("Newton: singular piece at iteration {it}"),
             );
         };
-        if rel_residual(c, w, qg, &ln, fr) <= TOL {
+        if rel_residual(c, qg, &ln, &dn, fr) <= TOL {
             return (
                 ln,
                 true,
                 format!("Newton converged in {} iterations", it + 1),
             );
         }
-        let dir: Vec<f64> = ln.iter().zip(&lam).map(|(a, b)| a - b).collect();
+        // The full step is the piece's solution; d is affine in λ, so a shorter step's d
+        // is interpolated for its merit, and computed afresh once the step is taken.
+        let between = |tau: f64| -> (Vec<f64>, Vec<f64>) {
+            let mix = |a: &[f64], b: &[f64]| -> Vec<f64> {
+                a.iter().zip(b).map(|(x, y)| x + tau * (y - x)).collect()
+            };
+            (mix(&lam, &ln), mix(&d, &dn))
+        };
         let mut tau = 1.0;
         let mut accepted = false;
         while tau > 1e-10 {
-            let trial: Vec<f64> = lam.iter().zip(&dir).map(|(l, d)| l + tau * d).collect();
-            let pt = merit(c, w, qg, &trial, fr);
+            let (trial, dt) = if tau == 1.0 {
+                (ln.clone(), dn.clone())
+            } else {
+                between(tau)
+            };
+            let pt = merit(c, qg, &trial, &dt, fr);
             if pt <= (1.0 - 1e-4 * tau) * phi {
+                d = if tau == 1.0 {
+                    dt
+                } else {
+                    displacement_gaps(w, qg, &trial)
+                };
                 lam = trial;
-                phi = pt;
+                phi = merit(c, qg, &lam, &d, fr);
                 accepted = true;
                 break;
             }
@@ -265,12 +284,12 @@ fn newton(
         if !accepted {
             let msg = format!(
                 "Newton: line search stalled at iteration {it} (residual {:e})",
-                rel_residual(c, w, qg, &lam, fr)
+                rel_residual(c, qg, &lam, &d, fr)
             );
             return (lam, false, msg);
         }
     }
-    let res = rel_residual(c, w, qg, &lam, fr);
+    let res = rel_residual(c, qg, &lam, &d, fr);
     (
         lam,
         false,
@@ -293,7 +312,8 @@ fn active_set(
     fr: Frozen<'_>,
 ) -> (Vec<f64>, bool, String) {
     let (c, w) = (pieces.c, pieces.w);
-    let mut res = rel_residual(c, w, qg, &lam0, fr);
+    let mut d = displacement_gaps(w, qg, &lam0);
+    let mut res = rel_residual(c, qg, &lam0, &d, fr);
     let mut best = (res, lam0.clone());
     let mut lam = lam0;
     let mut seen = std::collections::HashSet::new();
@@ -301,7 +321,7 @@ fn active_set(
         if res <= TOL {
             return (lam, true, format!("active set converged in {it} steps"));
         }
-        let classes = active_classes(c, w, qg, &lam, fr);
+        let classes = active_classes(c, &lam, &d, fr);
         if !seen.insert(classes.clone()) {
             return (
                 best.1,
@@ -309,15 +329,15 @@ fn active_set(
                 format!("active set: a cycle after {it} steps"),
             );
         }
-        let Some(next) = pieces.solve(&classes, qg) else {
+        let Some((next, dn)) = pieces.solve(&classes, qg) else {
             return (
                 best.1,
                 false,
                 format!("active set: singular piece at step {it}"),
             );
         };
-        lam = next;
-        res = rel_residual(c, w, qg, &lam, fr);
+        (lam, d) = (next, dn);
+        res = rel_residual(c, qg, &lam, &d, fr);
         if res < best.0 {
             best = (res, lam.clone());
         }

@@ -1454,13 +1454,8 @@ impl Path {
         if !self.problem.extended_precision() {
             return None;
         }
-        let classes = crate::solve::active_classes(
-            &self.consts(),
-            self.problem.delassus().w(),
-            qg,
-            &pt.lam,
-            None,
-        );
+        let d = crate::piece::displacement_gaps(self.problem.delassus().w(), qg, &pt.lam);
+        let classes = crate::solve::active_classes(&self.consts(), &pt.lam, &d, None);
         let piece = self.tangent(&classes, pt, self.force_scale(pt))?;
         if piece.scales.is_vertical(&piece.t) {
             return None;
