@@ -258,30 +258,39 @@ pub(crate) fn inf_norm(v: &[f64]) -> f64 {
 /// by faer's dispatch (a plain `.sum()` is one sequential chain of additions that the
 /// compiler may not reorder, about one addition per cycle).
 pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
-    struct Dot<'a>(&'a [f64], &'a [f64]);
-    impl faer::traits::pulp::WithSimd for Dot<'_> {
-        type Output = f64;
-        #[inline(always)]
-        fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) -> f64 {
-            let (a, b) = (self.0, self.1);
-            let n = a.len().min(b.len());
-            let (a, b) = (&a[..n], &b[..n]);
-            let mut s = [0.0f64; 8];
-            let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
-            let (ra, rb) = (ca.remainder(), cb.remainder());
-            for (x, y) in ca.zip(cb) {
-                for l in 0..8 {
-                    s[l] = x[l].mul_add(y[l], s[l]);
-                }
+    faer::traits::pulp::Arch::new().dispatch(Dot::<false>(a, b))
+}
+
+/// `Σ |a_i| b_i`, as [`dot`].
+pub(crate) fn abs_dot(a: &[f64], b: &[f64]) -> f64 {
+    faer::traits::pulp::Arch::new().dispatch(Dot::<true>(a, b))
+}
+
+/// The sum of [`dot`] (`ABS`: of [`abs_dot`]).
+struct Dot<'a, const ABS: bool>(&'a [f64], &'a [f64]);
+
+impl<const ABS: bool> faer::traits::pulp::WithSimd for Dot<'_, ABS> {
+    type Output = f64;
+    #[inline(always)]
+    fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) -> f64 {
+        let (a, b) = (self.0, self.1);
+        let n = a.len().min(b.len());
+        let (a, b) = (&a[..n], &b[..n]);
+        let f = |x: f64| if ABS { x.abs() } else { x };
+        let mut s = [0.0f64; 8];
+        let (ca, cb) = (a.chunks_exact(8), b.chunks_exact(8));
+        let (ra, rb) = (ca.remainder(), cb.remainder());
+        for (x, y) in ca.zip(cb) {
+            for l in 0..8 {
+                s[l] = f(x[l]).mul_add(y[l], s[l]);
             }
-            let mut tail = 0.0;
-            for (x, y) in ra.iter().zip(rb) {
-                tail += x * y;
-            }
-            ((s[0] + s[4]) + (s[1] + s[5])) + ((s[2] + s[6]) + (s[3] + s[7])) + tail
         }
+        let mut tail = 0.0;
+        for (x, y) in ra.iter().zip(rb) {
+            tail += f(*x) * y;
+        }
+        ((s[0] + s[4]) + (s[1] + s[5])) + ((s[2] + s[6]) + (s[3] + s[7])) + tail
     }
-    faer::traits::pulp::Arch::new().dispatch(Dot(a, b))
 }
 
 /// `y += a x`, compiled for the machine's vector instructions by faer's dispatch.
@@ -320,4 +329,28 @@ pub(crate) fn mat_mul(w: MatRef<'_, f64>, xs: &[&[f64]]) -> Vec<Vec<f64>> {
     (0..xs.len())
         .map(|j| out.col(j).iter().copied().collect())
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dot_and_abs_dot_sum_every_lane_and_the_tail() {
+        // a_i = (−1)^i (i + 1), b_i = 2 (i + 1): integer sums, exact in double. Lengths
+        // around the 8 lanes.
+        for n in [0usize, 1, 7, 8, 9, 16, 23, 100] {
+            let a: Vec<f64> = (0..n)
+                .map(|i| if i % 2 == 0 { 1.0 } else { -1.0 } * (i + 1) as f64)
+                .collect();
+            let b: Vec<f64> = (0..n).map(|i| 2.0 * (i + 1) as f64).collect();
+            // Σ ±2(i+1)² and Σ 2(i+1)², by hand: the alternating sum of squares of 1..n
+            // is (−1)^(n+1) n(n+1)/2, the sum n(n+1)(2n+1)/6.
+            let nf = n as f64;
+            let alt = if n % 2 == 1 { 1.0 } else { -1.0 } * nf * (nf + 1.0) / 2.0;
+            let all = nf * (nf + 1.0) * (2.0 * nf + 1.0) / 6.0;
+            assert_eq!(dot(&a, &b), 2.0 * if n == 0 { 0.0 } else { alt }, "n = {n}");
+            assert_eq!(abs_dot(&a, &b), 2.0 * all, "n = {n}");
+        }
+    }
 }

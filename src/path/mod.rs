@@ -342,12 +342,9 @@ impl TolRows {
             return v;
         }
         // Row k of the symmetric W, read as its contiguous column k.
-        let col = self.problem.delassus().w().col(k);
-        let wl: f64 = col
-            .iter()
-            .zip(&self.abs_lam)
-            .map(|(w, l)| w.abs() * l)
-            .sum();
+        let w = self.problem.delassus().w();
+        let col = w.col(k).try_as_col_major().expect("contiguous column");
+        let wl = crate::dense::abs_dot(col.as_slice(), &self.abs_lam);
         let v = (self.factor * (self.base[k] + wl)).max(self.floor);
         self.exact[k].store(v.to_bits(), Relaxed);
         v
