@@ -13,14 +13,67 @@ fn dips(
     a: &[GuardRow],
     b: &[GuardRow],
     len: f64,
-    tol: &[f64],
+    tol: &Thresholds,
     skip: impl Fn(usize) -> bool,
 ) -> bool {
     (0..b.len()).any(|k| {
         let (m0, m1) = (a[k].slope * len, b[k].slope * len);
         let sc = overflow_guard(&[a[k].value, b[k].value, m0, m1]);
-        !skip(k) && hermite_min(a[k].value * sc, b[k].value * sc, m0 * sc, m1 * sc) < -tol[k] * sc
+        !skip(k)
+            && tol.below(
+                k,
+                hermite_min(a[k].value * sc, b[k].value * sc, m0 * sc, m1 * sc),
+                sc,
+            )
     })
+}
+
+/// The zero thresholds ([`Tol::of`]) of the guards of a table at one point, each computed
+/// on first use: a displacement guard's reads a column of W (O(m)), so computing all of
+/// them at every step of a march cost O(m p) a step (half of a basis load's trace at
+/// p = 2000). Most comparisons are decided by the O(1) upper bound ([`Tol::upper`]);
+/// every comparison gives what it gives with all thresholds computed.
+struct Thresholds {
+    tol: Tol,
+    forms: Vec<crate::piece::LinForm>,
+    /// [`Tol::upper`], raised by 1e-10 of itself (the bound and the threshold are sums in
+    /// different orders: their roundings must not put the threshold above it).
+    upper: Vec<f64>,
+    exact: Vec<std::cell::OnceCell<f64>>,
+}
+
+impl Thresholds {
+    fn new(tol: Tol, forms: Vec<crate::piece::LinForm>) -> Self {
+        let upper = forms.iter().map(|f| tol.upper(f) * (1.0 + 1e-10)).collect();
+        let exact = forms.iter().map(|_| std::cell::OnceCell::new()).collect();
+        Self {
+            tol,
+            forms,
+            upper,
+            exact,
+        }
+    }
+
+    /// `v < −tol[k] sc` (`sc`: a power of two that scales v and the threshold alike).
+    fn below(&self, k: usize, v: f64, sc: f64) -> bool {
+        if v >= 0.0 {
+            return false;
+        }
+        v < -self.upper[k] * sc || v < -self[k] * sc
+    }
+
+    /// True where every one of `vs` is farther from zero than the threshold's bound: then
+    /// no comparison of them with ±`tol[k] sc` depends on the threshold's value.
+    fn clear_of(&self, k: usize, vs: &[f64], sc: f64) -> bool {
+        vs.iter().all(|v| v.abs() > self.upper[k] * sc)
+    }
+}
+
+impl std::ops::Index<usize> for Thresholds {
+    type Output = f64;
+    fn index(&self, k: usize) -> &f64 {
+        self.exact[k].get_or_init(|| self.tol.of(&self.forms[k]))
+    }
 }
 
 /// 2^-8 where a number of `v` exceeds [`NEAR_OVERFLOW`] (guards near the largest double,
@@ -739,16 +792,14 @@ impl Path {
         // that can take no longer step crawls at 1e-12 of the window and never ends.
         let mut forced = 0usize;
         loop {
-            let tol_at = self.tol_at(&pa);
-            let tol: Vec<f64> = {
+            let tol = {
                 let c = self.consts();
-                ga.iter()
-                    .map(|row| tol_at.of(&c.guard_form(row.guard)))
-                    .collect()
+                let forms = ga.iter().map(|row| c.guard_form(row.guard)).collect();
+                Thresholds::new(self.tol_at(&pa), forms)
             };
             let below = below.get_or_insert_with(|| {
                 (0..ga.len())
-                    .map(|k| ga[k].value < -tol[k] && dir * ga[k].slope > 0.0)
+                    .map(|k| dir * ga[k].slope > 0.0 && tol.below(k, ga[k].value, 1.0))
                     .collect()
             });
             let at_bound = (bound - pa.alpha).abs() <= h;
@@ -773,9 +824,9 @@ impl Path {
             // the step overshoots the piece's first stretch; shorten it.
             let premature = (0..gb.len()).any(|k| {
                 !below[k]
-                    && ga[k].value <= tol[k]
                     && dir * ga[k].slope > 0.0
-                    && gb[k].value < -tol[k]
+                    && tol.below(k, gb[k].value, 1.0)
+                    && ga[k].value <= tol[k]
             });
             if premature && h > hmin {
                 h *= 0.5;
@@ -807,10 +858,10 @@ impl Path {
             };
             for k in 0..gb.len() {
                 let flat = 1e-9 * ga[k].value.min(gb[k].value);
-                if ga[k].value > -tol[k]
-                    && gb[k].value >= -tol[k]
-                    && dir * ga[k].slope < 0.0
+                if dir * ga[k].slope < 0.0
                     && dir * gb[k].slope > 0.0
+                    && ga[k].value > -tol[k]
+                    && gb[k].value >= -tol[k]
                     && (ga[k].slope * delta_b)
                         .abs()
                         .max((gb[k].slope * delta_b).abs())
@@ -886,7 +937,12 @@ impl Path {
                     // (exact; the test is homogeneous in them).
                     let sc = overflow_guard(&[v0, v1, vm, m0, m1]);
                     let (v0, v1, vm, m0, m1) = (v0 * sc, v1 * sc, vm * sc, m0 * sc, m1 * sc);
-                    let tol_k = tol[k] * sc;
+                    // (where all of v0, v1, vm are beyond the threshold's bound, or v0 and
+                    // v1 on either side of it and vm too, nothing below depends on tol_k:
+                    // 0 stands for it)
+                    let clear = tol.clear_of(k, &[v0, v1, vm], sc)
+                        && ((v0 > 0.0 && v1 > 0.0 && vm > 0.0) || (v0 > 0.0 && v1 < 0.0));
+                    let tol_k = if clear { 0.0 } else { tol[k] * sc };
                     let slope_m = gm[k].slope * delta * sc;
                     let model = 0.5 * (v0 + v1) + 0.125 * (m0 - m1);
                     let margin = if v0 > tol_k && v1 < -tol_k {
@@ -919,7 +975,9 @@ impl Path {
             }
             self.graph_step.set(Some(delta.abs()));
             let crossing: Vec<usize> = (0..gb.len())
-                .filter(|&k| gb[k].value < -tol[k] && !(below[k] && dir * gb[k].slope > 0.0))
+                .filter(|&k| {
+                    tol.below(k, gb[k].value, 1.0) && !(below[k] && dir * gb[k].slope > 0.0)
+                })
                 .collect();
             if crossing.is_empty() {
                 // Hermite check for a dip below zero inside the step
@@ -936,7 +994,7 @@ impl Path {
                     return Ok(Exit::Window(pt));
                 }
                 for (k, b) in below.iter_mut().enumerate() {
-                    *b = *b && gb[k].value < -tol[k];
+                    *b = *b && tol.below(k, gb[k].value, 1.0);
                 }
                 behind = Some((pa.alpha, ga));
                 pa = pb;
