@@ -937,11 +937,11 @@ impl Path {
                     // (exact; the test is homogeneous in them).
                     let sc = overflow_guard(&[v0, v1, vm, m0, m1]);
                     let (v0, v1, vm, m0, m1) = (v0 * sc, v1 * sc, vm * sc, m0 * sc, m1 * sc);
-                    // (where all of v0, v1, vm are beyond the threshold's bound, or v0 and
-                    // v1 on either side of it and vm too, nothing below depends on tol_k:
-                    // 0 stands for it)
-                    let clear = tol.clear_of(k, &[v0, v1, vm], sc)
-                        && ((v0 > 0.0 && v1 > 0.0 && vm > 0.0) || (v0 > 0.0 && v1 < 0.0));
+                    // (where v0, v1, vm are all beyond the threshold's bound, v0 above it,
+                    // and vm above it or v1 below it, nothing below depends on tol_k: 0
+                    // stands for it)
+                    let clear =
+                        tol.clear_of(k, &[v0, v1, vm], sc) && v0 > 0.0 && (v1 < 0.0 || vm > 0.0);
                     let tol_k = if clear { 0.0 } else { tol[k] * sc };
                     let slope_m = gm[k].slope * delta * sc;
                     let model = 0.5 * (v0 + v1) + 0.125 * (m0 - m1);
