@@ -35,13 +35,13 @@ fn frozen_class(frozen: Frozen<'_>, i: usize) -> Option<Class> {
     frozen.and_then(|f| f[i])
 }
 
-/// `H2, H3` of the seed (2p values) at `λ` (with its `d = q − (g, 0) + W λ`), and the force scale of each node (p values)
-/// that makes its two entries relative: the magnitudes of the node's own terms (`λ_i`,
-/// `r d_i`, `r (q − g)_i`, `r (W λ)_i`), but not below a thousandth of the point's force
-/// scale (forces, `r W λ`, and `r q` where the load alone presses or shears). A node far
-/// from the foundation (a large gap) does not set the scale of the others, and a node
-/// with small forces is held to its own. Frozen nodes contribute the residuals of their
-/// class's equations instead.
+/// `H2, H3` of the seed (2p values) at `λ` (with its `d = q − (g, 0) + W λ`), and the
+/// force scale of each node (p values) that makes its two entries relative: the
+/// magnitudes of the node's own terms (`λ_i`, `r d_i`, `r (q − g)_i`, `r (W λ)_i`), but
+/// not below a thousandth of the point's force scale (forces, `r W λ`, and `r q` where
+/// the load alone presses or shears). A node far from the foundation (a large gap) does
+/// not set the scale of the others, and a node with small forces is held to its own.
+/// Frozen nodes contribute the residuals of their class's equations instead.
 fn h_condensed(
     c: &PieceConstants,
     qg: &[f64],
