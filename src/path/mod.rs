@@ -1137,32 +1137,35 @@ impl Path {
         // neighbouring piece that residual is at rounding level, and so is the
         // correction's error; its solve shares the pass over the base's factor with the
         // new nodes' columns.
+        // Where that residual is at rounding level already, the point is kept as it is
+        // (a correction would be below its rounding) and neither pass carries it.
+        let corrected = update::relative_residual(&c, classes, &resid, &pt.lam, &rhs, rb)
+            > update::REFINE_ABOVE;
+        let extras = if corrected {
+            std::slice::from_ref(&resid)
+        } else {
+            &[]
+        };
         let extended = self
             .updater
             .borrow()
             .as_ref()
             .filter(|u| u.reaches(classes))
-            .and_then(|u| {
-                u.extend(
-                    &c,
-                    w,
-                    classes,
-                    targets.as_deref(),
-                    std::slice::from_ref(&resid),
-                )
-            });
+            .and_then(|u| u.extend(&c, w, classes, targets.as_deref(), extras));
         let on_update = |(mut u, dx): (UpdatedLu, Vec<Vec<f64>>)| {
             // W times the point's correction and the carried columns: one pass over W.
             let carried = u.carried();
-            let mut cols: Vec<&[f64]> = vec![&dx[0]];
+            let mut cols: Vec<&[f64]> = dx.iter().map(|v| &v[..]).collect();
             if let Some(cs) = &carried {
                 cols.extend(cs.iter().map(|v| &v[..]));
             }
             let mut prods = crate::dense::mat_mul(w, &cols).into_iter();
             // The point and its residual from the data; refined once when that is above
             // rounding level, and then it must be small.
-            let mut xp = add(&pt.lam, &dx[0]);
-            let mut dp = add(&d, &prods.next()?);
+            let (mut xp, mut dp) = match dx.first() {
+                Some(dx) => (add(&pt.lam, dx), add(&d, &prods.next()?)),
+                None => (pt.lam.clone(), d.to_vec()),
+            };
             let mut r = update::residual_rows(&c, classes, &xp, &dp, &zeros);
             if update::relative_residual(&c, classes, &r, &xp, &rhs, rb) > update::REFINE_ABOVE {
                 let dx2 = u.solve_many(&c, std::slice::from_ref(&r)).pop()?;
