@@ -214,8 +214,8 @@ pub struct Delassus {
     /// `W_lo`: `W_hi + W_lo` is `B A⁻¹ Bᵀ` to double-double accuracy, `W_hi` = `w` (None:
     /// not refined, see [`Self::refine_w`]).
     w_lo: Option<Mat<f64>>,
-    /// The factorised matrix (`h² A`, full storage) kept for refining load vectors when W
-    /// was refined.
+    /// The factorised matrix (`h² A`, full storage, shared with the problem) kept for
+    /// refining load vectors ([`Self::keep_matrix`], [`Self::refine_w`]).
     a_full: Option<std::sync::Arc<CsrMatrix>>,
     /// Estimate of the 2-norm condition number of W ([`Self::w_condition_estimate`]).
     cond: f64,
@@ -1050,6 +1050,15 @@ impl Delassus {
         Ok(())
     }
 
+    /// Keeps the factorised matrix (`h² A`, both triangles; [`crate::Problem::a`], shared,
+    /// not copied) for [`Self::condense_error`] where W is not refined. A no-op for a
+    /// host's solve and condensed input.
+    pub(crate) fn keep_matrix(&mut self, a_full: std::sync::Arc<CsrMatrix>) {
+        if matches!(self.op, Operator::Cholesky { .. }) {
+            self.a_full = Some(a_full);
+        }
+    }
+
     /// The low parts of condensed load vectors: for each load vector `f_j` (n entries, the
     /// caller's units) and its condensed image `q_j` as fricont stores it (2p entries),
     /// `exact((B / h) A⁻¹ f_j) − q_j` rounded to double, by the refinement that gave W's
@@ -1057,6 +1066,23 @@ impl Delassus {
     /// W was not refined ([`Self::w_lo`] is None): then q is used as stored.
     /// Errors: lengths that do not match; out of memory.
     pub fn condense_lo(&self, f: &[&[f64]], q: &[&[f64]]) -> Result<Option<Vec<Vec<f64>>>> {
+        if self.w_lo.is_none() {
+            return Ok(None);
+        }
+        self.condense_error(f, q)
+    }
+
+    /// What [`Self::condense_lo`] computes, `exact((B / h) A⁻¹ f_j) − q_j` rounded to
+    /// double, wherever the factorised matrix is kept ([`Self::keep_matrix`]), whether W
+    /// was refined or not: the error of each condensed vector as the solve left it (about
+    /// κ(A) ε of the whole vector, in every row, also where the exact row is 0). None for
+    /// a host's solve and condensed input. Errors: as [`Self::condense_lo`]; the
+    /// refinement diverged ([`Error::Numerical`], A too ill-conditioned for double).
+    pub(crate) fn condense_error(
+        &self,
+        f: &[&[f64]],
+        q: &[&[f64]],
+    ) -> Result<Option<Vec<Vec<f64>>>> {
         let Some(a_full) = self.a_full.as_ref() else {
             return Ok(None);
         };

@@ -20,6 +20,7 @@
 //! Either stops the path cleanly with [`crate::Error::Load`], keeping what was traced.
 
 use crate::condense::Delassus;
+use crate::dense::inf_norm;
 use crate::error::{Error, Result};
 
 /// Why a load closure failed: the caller's own code (kept and reported) and a message.
@@ -163,6 +164,9 @@ pub(crate) struct BoundLoad {
     /// ([`Delassus::condense_lo`]). None otherwise (and for condensed input, whose q is the
     /// caller's data, and for a general load).
     q_lo: Option<Vec<Vec<f64>>>,
+    /// `‖exact(B A⁻¹ f_j) − q_j‖∞` of each vector as the solve gave it (computed on first
+    /// use, see [`Self::determination`]).
+    errors: std::cell::OnceCell<Option<Vec<f64>>>,
     /// The same vectors half-solved, `L⁻¹ Pᵀ f_j` (n × k), when the problem has half
     /// solves ([`Delassus::displacements`]): u at an event then costs a backward half only.
     half: Option<faer::Mat<f64>>,
@@ -225,6 +229,11 @@ impl BoundLoad {
         };
         // With low parts, q_j becomes B A⁻¹ f_j correctly rounded (the stored q_j is
         // accurate only to ~κ(A) ε), and its low part the rest.
+        // (where W was refined, the solves' errors are at hand: see `condensation_errors`)
+        let errors = std::cell::OnceCell::new();
+        if let Some(lo) = &q_lo {
+            let _ = errors.set(Some(lo.iter().map(|l| inf_norm(l)).collect()));
+        }
         let mut q_basis = q_basis;
         if let Some(lo) = &mut q_lo {
             for (q, l) in q_basis.iter_mut().zip(lo.iter_mut()) {
@@ -237,6 +246,7 @@ impl BoundLoad {
             load,
             q_basis,
             q_lo,
+            errors,
             half,
             weights: vec![0.0; k],
             dweights: vec![0.0; k],
@@ -277,6 +287,65 @@ impl BoundLoad {
                 })
                 .collect(),
         )
+    }
+
+    /// `‖δq_j‖∞` for each vector of an affine or basis load: the error of the solve that
+    /// condensed `f_j` (kept from the low parts where W was refined, else found by the same
+    /// refinement, [`Delassus::condense_error`]: a few solves with the factor of A per
+    /// vector, once). None for a general load, a host's solve, condensed input, or where
+    /// the refinement fails.
+    fn condensation_errors(&self, del: &Delassus) -> Option<&[f64]> {
+        self.errors
+            .get_or_init(|| {
+                let f: Vec<&[f64]> = match &self.load {
+                    Load::Affine { f0, f1 } => vec![f0, f1],
+                    Load::Basis { vectors, .. } => vectors.iter().map(|v| v.as_slice()).collect(),
+                    Load::General { .. } => return None,
+                };
+                let q: Vec<&[f64]> = self.q_basis.iter().map(|v| v.as_slice()).collect();
+                let lo = del.condense_error(&f, &q).ok()??;
+                Some(lo.iter().map(|l| inf_norm(l)).collect())
+            })
+            .as_deref()
+    }
+
+    /// How far the data determine each row of `q(α)`: `Σ_j |w_j(α)| ‖δq_j‖∞`
+    /// ([`Self::condensation_errors`], about κ(A) ε ‖q_j‖∞ in every row; the weights as in
+    /// [`Self::term_magnitude_rows`]). Perturbing A by its own rounding (an element matrix
+    /// whose entries that are equal by symmetry came out of different sums) moves q by
+    /// about as much, so a row below it has no sign: on a mirror-symmetric body, the node
+    /// on the axis touched down with a tangential displacement of 1.6e-14 of the load's
+    /// scale where it is 0 by symmetry, and no class fitted it. None where not known. Used
+    /// only where no neighbouring piece continues the path at the usual thresholds.
+    pub(crate) fn determination(&self, alpha: f64, del: &Delassus) -> Option<f64> {
+        let w: Vec<f64> = match &self.load {
+            Load::Affine { .. } => vec![1.0, alpha.abs()],
+            // (the latest weights where α's are no longer among the recent ones)
+            Load::Basis { .. } => self
+                .recent_weights
+                .iter()
+                .rev()
+                .find(|(a, _)| *a == alpha)
+                .or(self.recent_weights.last())?
+                .1
+                .iter()
+                .map(|w| w.abs())
+                .collect(),
+            Load::General { .. } => return None,
+        };
+        let e = self.condensation_errors(del)?;
+        Some(w.iter().zip(e).map(|(a, b)| a * b).sum())
+    }
+
+    /// `max_j ‖δq_j‖∞ / ‖q_j‖∞` ([`Self::condensation_errors`]): the relative error of the
+    /// condensation in double, about κ(A) ε. None where not known.
+    pub(crate) fn relative_determination(&self, del: &Delassus) -> Option<f64> {
+        self.condensation_errors(del)?
+            .iter()
+            .zip(&self.q_basis)
+            .map(|(e, q)| e / inf_norm(q))
+            .filter(|r| r.is_finite())
+            .reduce(f64::max)
     }
 
     /// `(q0_lo, q1_lo)`: the low parts of the condensed affine load `q(α) = q0 + α q1`

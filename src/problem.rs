@@ -715,6 +715,8 @@ impl ProblemBuilder {
                 };
                 if refine {
                     del.refine_w(full_a.clone())?;
+                } else {
+                    del.keep_matrix(full_a.clone());
                 }
                 let mut b = b_unit;
                 b.scale_pow2(-k / 2);

@@ -5,7 +5,46 @@
 use super::advance::GuardRow;
 use super::*;
 
+/// The widest of `transit`'s last-resort thresholds, as a multiple of the usual ones.
+const MAX_WIDENING: f64 = 64.0;
+
+/// The pieces before the current one that `transit` compares a candidate with (a way back
+/// along one of them, across pieces a rounding long, is not a branch).
+const RETRACE_LOOKBACK: usize = 4;
+
+/// A piece "a rounding long" for `transit`: α and the contact forces change by at most this
+/// fraction along it (mirrored nodes of a symmetric body in double switch up to 1e-9
+/// apart).
+const ROUNDING_LONG: f64 = 1e-8;
+
 impl Path {
+    /// `transit`'s last-resort thresholds at `pt`, as arguments of [`Tol::widened`]: first
+    /// no displacement row's below twice how far the data determine q's rows
+    /// ([`crate::load::BoundLoad::determination`], in force units); then, in double, all
+    /// of them 4, 16 and 64 times wider, as far as κ(W) times the relative error of the
+    /// condensation ([`crate::load::BoundLoad::relative_determination`], about κ(A) ε)
+    /// exceeds `zero_tol` (the forces are undetermined by that much). Empty where none of
+    /// this is known (a general load, a host's solve, condensed input).
+    fn widening(&self, pt: &Point) -> Vec<(f64, f64)> {
+        let del = self.problem.delassus();
+        let Some(det) = self.load.determination(pt.alpha, del) else {
+            return Vec::new();
+        };
+        let min_row = 2.0 * self.problem.default_r() * det;
+        let mut out = vec![(1.0, min_row)];
+        if !self.problem.extended_precision() {
+            let bound = self.load.relative_determination(del).map_or(1.0, |rho| {
+                self.problem.w_condition_estimate() * rho / self.opts.zero_tol
+            });
+            let mut k = 4.0;
+            while k <= bound.min(MAX_WIDENING) {
+                out.push((k, min_row));
+                k *= 4.0;
+            }
+        }
+        out
+    }
+
     /// Classes of each node in `nodes` whose equations and guards hold at the point (to
     /// `tol`, in force units). One product with W for all of them.
     pub(super) fn compatible(&self, nodes: &[usize], pt: &Point, tol: &Tol) -> Vec<Vec<Class>> {
@@ -62,6 +101,7 @@ impl Path {
         back: Option<(&[Class], &[f64])>,
         relaxed: bool,
         out: &mut Vec<Candidate>,
+        blockers: &mut Vec<usize>,
     ) {
         // The piece the path came from cannot continue it: its crossing guard decreases
         // forward, and backward is where the path came from.
@@ -93,7 +133,8 @@ impl Path {
                 continue;
             }
             let c = self.consts();
-            let enters = table.iter().all(|row| {
+            // None: the guard lets the direction in; Some(at zero): it does not.
+            let blocks = |row: &GuardRow| -> Option<bool> {
                 let (v, vd) = (row.value, s * row.slope);
                 // A guard not at zero must be inside; one at zero (see Tol::at_zero) must
                 // increase: its slope (force per unit of scaled arclength) against the
@@ -105,11 +146,24 @@ impl Path {
                     tol
                 };
                 if !tol_row.at_zero(&form, v, vd) {
-                    return v > 0.0;
+                    return if v > 0.0 { None } else { Some(false) };
                 }
                 let ts = tol.slope();
-                if relaxed { vd >= -ts } else { vd > ts }
-            });
+                let ok = if relaxed { vd >= -ts } else { vd > ts };
+                (!ok).then_some(true)
+            };
+            let enters = table.iter().all(|row| blocks(row).is_none());
+            if !enters {
+                // Nodes not switching whose guard is at zero and leaves: see `transit`.
+                blockers.extend(
+                    table
+                        .iter()
+                        .filter(|row| {
+                            !switching.contains(&row.guard.node) && blocks(row) == Some(true)
+                        })
+                        .map(|row| row.guard.node),
+                );
+            }
             if enters {
                 let orientation = if s > 0.0 {
                     lu_orientation
@@ -149,6 +203,7 @@ impl Path {
     /// when there are more than two of them: the continuation from such a point is
     /// positively homogeneous, so their classes are read off the solution of the
     /// directional contact problem `ḋ = W λ̇ ± q'` (the other nodes keep their class).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn continuations(
         &self,
         pt: &Point,
@@ -156,13 +211,16 @@ impl Path {
         nodes: &[usize],
         back: Option<(&[Class], &[f64])>,
         relaxed: bool,
+        blockers: &mut Vec<usize>,
+        widen: (f64, f64),
     ) -> Result<Vec<Candidate>> {
         let scale = self.force_scale(pt);
         // A start (no way in) is a point of the fixed-α solver, known to its accuracy.
         let tol = match back {
             Some(_) => self.tol_at(pt),
             None => self.tol_at(pt).approximate(),
-        };
+        }
+        .widened(widen);
         let options: Vec<Vec<Class>> = self.compatible(nodes, pt, &tol);
         if let Some(k) = options.iter().position(|o| o.is_empty()) {
             return Err(Error::Numerical(format!(
@@ -213,11 +271,15 @@ impl Path {
                     .collect();
                 for s in [1.0, -1.0] {
                     if let Some(cl) = self.directional_classes(pt, &frozen, s) {
-                        self.push_candidates(&cl, pt, scale, &tol, nodes, back, relaxed, &mut out);
+                        self.push_candidates(
+                            &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
+                        );
                     }
                 }
             } else {
-                self.push_candidates(&classes, pt, scale, &tol, nodes, back, relaxed, &mut out);
+                self.push_candidates(
+                    &classes, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
+                );
             }
             // next combination
             let mut k = 0;
@@ -233,6 +295,24 @@ impl Path {
                 k += 1;
             }
         }
+    }
+
+    /// [`Self::continuations`] with the slopes of guards at zero strictly positive, else,
+    /// where that finds none, with slopes within their threshold of zero.
+    pub(super) fn continuations_either(
+        &self,
+        pt: &Point,
+        fixed: &[Class],
+        nodes: &[usize],
+        back: Option<(&[Class], &[f64])>,
+        blockers: &mut Vec<usize>,
+        widen: (f64, f64),
+    ) -> Result<Vec<Candidate>> {
+        let cands = self.continuations(pt, fixed, nodes, back, false, blockers, widen)?;
+        if !cands.is_empty() {
+            return Ok(cands);
+        }
+        self.continuations(pt, fixed, nodes, back, true, blockers, widen)
     }
 
     /// Classes of the free (vertex) nodes on the continuation with `α̇ = s`: the solution of
@@ -298,9 +378,106 @@ impl Path {
         let entry = self.point_at(cur.lam.clone(), cur.alpha)?;
         let pt = self.snap_to_vertex(pt, &tol, &entry)?;
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
-        let mut cands = self.continuations(&pt, &cur.classes, &nodes, back, false)?;
-        if cands.is_empty() {
-            cands = self.continuations(&pt, &cur.classes, &nodes, back, true)?;
+        let usual = (1.0, 0.0);
+        let mut blockers = Vec::new();
+        let mut cands =
+            self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, usual)?;
+        // A node that the way in found clear of zero (its guard crossing a step beyond
+        // `zero_tol` along the old piece) may be at zero and leaving along every
+        // neighbouring piece: it switches here too. Transitions a rounding apart look like
+        // that: mirrored nodes of a symmetric body in double, whose W is symmetric to
+        // rounding only, crossed 9.6e-12 apart in arclength (zero_tol 1e-11), and no piece
+        // with one of them switching continued the path.
+        blockers.retain(|i| !nodes.contains(i));
+        if cands.is_empty() && !blockers.is_empty() {
+            nodes.append(&mut blockers);
+            nodes.sort_unstable();
+            nodes.dedup();
+            cands =
+                self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, usual)?;
+        }
+        // After pieces a rounding long (transitions a rounding apart, as above), the pieces
+        // before them contain the point too, within the thresholds, and walked backwards
+        // they enter their regions: that is the way the path came, not a branch (mirrored
+        // nodes in double were flagged as bifurcations, one and two pieces back). Only
+        // across such pieces: a path that comes back to a bifurcation point along pieces
+        // of some length may go on along one it walked the other way.
+        let recent: Vec<(Vec<Class>, i8)> = {
+            let tiny = |a0: f64, a1: f64, l0: &[f64], l1: &[f64]| {
+                let scale = inf_norm(l0).max(inf_norm(l1));
+                let dl = l0
+                    .iter()
+                    .zip(l1)
+                    .map(|(x, y)| (x - y).abs())
+                    .fold(0.0, f64::max);
+                (a1 - a0).abs() <= ROUNDING_LONG * a0.abs().max(1.0) && dl <= ROUNDING_LONG * scale
+            };
+            let tr = self.trace.as_ref().expect("started");
+            let mut out = Vec::new();
+            if tiny(cur.alpha, pt.alpha, &cur.lam, &pt.lam) {
+                let n = tr.pieces.len().saturating_sub(1);
+                for p in tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n]
+                    .iter()
+                    .rev()
+                {
+                    out.push((p.classes.clone(), p.direction));
+                    if !tiny(p.alpha_from, p.alpha_to, &p.lambda_from, &p.lambda_to) {
+                        break;
+                    }
+                }
+            }
+            out
+        };
+        let without_retrace = |mut cands: Vec<Candidate>| {
+            let retraces = |cd: &Candidate| {
+                let t_alpha = cd.t.last().copied().unwrap_or(0.0);
+                recent.iter().any(|(classes, direction)| {
+                    cd.classes == *classes && t_alpha * f64::from(*direction) < 0.0
+                })
+            };
+            if cands.len() > 1 && cands.iter().any(|cd| !retraces(cd)) {
+                cands.retain(|cd| !retraces(cd));
+            }
+            cands
+        };
+        cands = without_retrace(cands);
+        // The last resort where the usual thresholds find no continuation or several, as
+        // the data may determine the point less well than they assume (`widening`): no
+        // displacement row's threshold below how far the data determine q's rows, then
+        // all thresholds 4, 16, 64 times wider as far as the forces are undetermined (in
+        // double only). The first that finds exactly one continuation is taken; else what
+        // the usual thresholds found, or, where they found none, the first that finds any.
+        // On mirror-symmetric bodies, whose W and q are symmetric to about κ(A) ε only:
+        // the node on the axis touched down with a tangential displacement of 1.6e-14 of
+        // the load's scale (0 by symmetry) and no class fitted it; in double a mirrored
+        // node's contact forces came out 1.2e-11 of the forces apart from its image's
+        // (zero_tol 1e-11), and the class its image took did not fit it; and the node on
+        // the axis, lifting off, reached its stick cone 3.6e-11 of the forces before λ = 0
+        // (its λt is rounding there), where slip in either direction continued the path: a
+        // bifurcation, and the path stopped, where it lifts off.
+        if cands.len() != 1 {
+            let mut first = None;
+            for widen in self.widening(&pt) {
+                let wider = without_retrace(self.continuations_either(
+                    &pt,
+                    &cur.classes,
+                    &nodes,
+                    back,
+                    &mut blockers,
+                    widen,
+                )?);
+                if wider.len() == 1 {
+                    cands = wider;
+                    first = None;
+                    break;
+                }
+                if first.is_none() && !wider.is_empty() {
+                    first = Some(wider);
+                }
+            }
+            if let (true, Some(w)) = (cands.is_empty(), first) {
+                cands = w;
+            }
         }
         self.close_piece(&pt);
         let (events_start, pieces_len, last_dir, sigma) = {

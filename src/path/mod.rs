@@ -312,6 +312,10 @@ pub(super) struct Tol {
     /// [`ROUNDING`] at a point found exactly (a transition point), 1 at a point of the
     /// fixed-α solver (a start), which is accurate to its 1e-12 only.
     rounding: f64,
+    /// Factor on the per-row thresholds and a floor under them ([`Tol::widened`]; 1 and 0
+    /// otherwise).
+    widen: f64,
+    min_row: f64,
 }
 
 /// The rounding of a guard's value at an exactly computed point, as a fraction of
@@ -366,6 +370,8 @@ impl Tol {
             rows: None,
             arc: 0.0,
             rounding: 1.0,
+            widen: 1.0,
+            min_row: 0.0,
         }
     }
 
@@ -373,6 +379,18 @@ impl Tol {
     /// only (see [`Tol::rounding`]).
     fn approximate(mut self) -> Self {
         self.rounding = 1.0;
+        self
+    }
+
+    /// Every threshold (and `arc`) times `k`, and no displacement row's below `min_row`
+    /// (force units): see `join::transit`, the last resort where no neighbouring piece
+    /// continues the path.
+    pub(super) fn widened(mut self, (k, min_row): (f64, f64)) -> Self {
+        self.force *= k;
+        self.disp *= k;
+        self.arc *= k;
+        self.widen *= k;
+        self.min_row = self.min_row.max(min_row);
         self
     }
 
@@ -387,7 +405,8 @@ impl Tol {
         if f.disp.coef != 0.0 {
             self.rows
                 .as_ref()
-                .map_or(self.disp, |r| r.exact(f.disp.index))
+                .map_or(self.disp, |r| self.widen * r.exact(f.disp.index))
+                .max(self.min_row)
         } else {
             self.force * (f.lam[0].coef.abs() + f.lam[1].coef.abs()).max(1.0)
         }
@@ -412,7 +431,7 @@ impl Tol {
     /// threshold without computing the threshold.
     fn upper(&self, f: &crate::piece::LinForm) -> f64 {
         match (&self.rows, f.disp.coef != 0.0) {
-            (Some(r), true) => r.upper(f.disp.index),
+            (Some(r), true) => (self.widen * r.upper(f.disp.index)).max(self.min_row),
             _ => self.of(f),
         }
     }
@@ -820,6 +839,8 @@ impl Path {
             rows: Some(Arc::new(rows)),
             arc: z,
             rounding: ROUNDING,
+            widen: 1.0,
+            min_row: 0.0,
         };
         self.tol_cache.put(pt.alpha, &pt.lam, tol.clone());
         tol
@@ -1388,10 +1409,8 @@ impl Path {
             }
         }
         let want = sign(self.opts.alpha_end - self.opts.alpha_start);
-        let mut cands = self.continuations(&pt, &fixed, &nodes, None, false)?;
-        if cands.is_empty() {
-            cands = self.continuations(&pt, &fixed, &nodes, None, true)?;
-        }
+        let cands =
+            self.continuations_either(&pt, &fixed, &nodes, None, &mut Vec::new(), (1.0, 0.0))?;
         let ms = 2 * p;
         let toward: Vec<usize> = (0..cands.len())
             .filter(|&k| cands[k].direction() == want)
