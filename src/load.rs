@@ -263,19 +263,7 @@ impl BoundLoad {
     /// `|q_k(α)|`, which can cancel to zero. `None` for a general load (or basis weights
     /// not evaluated at α lately).
     pub(crate) fn term_magnitude_rows(&self, alpha: f64) -> Option<Vec<f64>> {
-        let w: Vec<f64> = match &self.load {
-            Load::Affine { .. } => vec![1.0, alpha.abs()],
-            Load::Basis { .. } => self
-                .recent_weights
-                .iter()
-                .rev()
-                .find(|(a, _)| *a == alpha)?
-                .1
-                .iter()
-                .map(|w| w.abs())
-                .collect(),
-            _ => return None,
-        };
+        let w = self.abs_weights(alpha, false)?;
         let m = self.q_basis.first()?.len();
         Some(
             (0..m)
@@ -287,6 +275,22 @@ impl BoundLoad {
                 })
                 .collect(),
         )
+    }
+
+    /// `|w_j(α)|`: `(1, |α|)` for an affine load; a basis load's weights at α if among its
+    /// last few evaluations, or else, with `latest`, its latest ones. None for a general
+    /// load (or a basis load's weights not at hand).
+    fn abs_weights(&self, alpha: f64, latest: bool) -> Option<Vec<f64>> {
+        match &self.load {
+            Load::Affine { .. } => Some(vec![1.0, alpha.abs()]),
+            Load::Basis { .. } => {
+                let mut recent = self.recent_weights.iter().rev();
+                let at = recent.clone().find(|(a, _)| *a == alpha);
+                let (_, w) = if latest { at.or(recent.next())? } else { at? };
+                Some(w.iter().map(|w| w.abs()).collect())
+            }
+            Load::General { .. } => None,
+        }
     }
 
     /// `‖δq_j‖∞` for each vector of an affine or basis load: the error of the solve that
@@ -316,23 +320,10 @@ impl BoundLoad {
     /// about as much, so a row below it has no sign: on a mirror-symmetric body, the node
     /// on the axis touched down with a tangential displacement of 1.6e-14 of the load's
     /// scale where it is 0 by symmetry, and no class fitted it. None where not known. Used
-    /// only where no neighbouring piece continues the path at the usual thresholds.
+    /// only where the usual thresholds find no continuation, or several (the latest
+    /// weights of a basis load stand in for α's where those are no longer at hand).
     pub(crate) fn determination(&self, alpha: f64, del: &Delassus) -> Option<f64> {
-        let w: Vec<f64> = match &self.load {
-            Load::Affine { .. } => vec![1.0, alpha.abs()],
-            // (the latest weights where α's are no longer among the recent ones)
-            Load::Basis { .. } => self
-                .recent_weights
-                .iter()
-                .rev()
-                .find(|(a, _)| *a == alpha)
-                .or(self.recent_weights.last())?
-                .1
-                .iter()
-                .map(|w| w.abs())
-                .collect(),
-            Load::General { .. } => return None,
-        };
+        let w = self.abs_weights(alpha, true)?;
         let e = self.condensation_errors(del)?;
         Some(w.iter().zip(e).map(|(a, b)| a * b).sum())
     }

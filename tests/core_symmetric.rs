@@ -269,6 +269,25 @@ fn assert_mirrored(ctx: &str, ev: &[(f64, usize, Class, Class)], nx: usize) -> u
     pairs
 }
 
+/// The basis load `f0 + 2 sin(50 α) f1` of `case` and the end of its window, two periods
+/// from α = 0.
+fn oscillating_load(case: &Case) -> (fricont::Load, f64) {
+    let omega = 50.0;
+    let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+        w[0] = 1.0;
+        w[1] = 2.0 * (omega * a).sin();
+        dw[0] = 0.0;
+        dw[1] = 2.0 * omega * (omega * a).cos();
+        Ok::<(), fricont::load::LoadFailure>(())
+    };
+    let fs = vec![
+        case.data.f0.as_slice().to_vec(),
+        case.data.f1.as_slice().to_vec(),
+    ];
+    let load = fricont::Load::basis(fs, Box::new(weights)).expect("basis load");
+    (load, 4.0 * std::f64::consts::PI / omega)
+}
+
 /// Mirror-symmetric finite-element bodies under an oscillating load: the body and load
 /// family of [`mirror_symmetric_finite_element_bodies`] with the basis load `f0 +
 /// 2 sin(50 α) f1` over two periods (the symmetric press held, the symmetric bump and
@@ -282,17 +301,7 @@ fn mirror_symmetric_bodies_under_an_oscillating_load() {
     for seed in 0..24u64 {
         let (case, nx, ctx) = mirror_body(seed);
         let data = &case.data;
-        let omega = 50.0;
-        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
-            w[0] = 1.0;
-            w[1] = 2.0 * (omega * a).sin();
-            dw[0] = 0.0;
-            dw[1] = 2.0 * omega * (omega * a).cos();
-            Ok::<(), fricont::load::LoadFailure>(())
-        };
-        let fs = vec![data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec()];
-        let load = fricont::Load::basis(fs, Box::new(weights)).expect("basis load");
-        let a1 = 4.0 * std::f64::consts::PI / omega;
+        let (load, a1) = oscillating_load(&case);
         let mut path =
             Path::new(Arc::new(data.problem()), load, PathOptions::window(0.0, a1)).expect("path");
         path.start(0.0, None).expect("start");
@@ -496,9 +505,8 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
         let ctx = format!("seed {seed} (nx = {nx}, ny = {ny}, F = {friction})");
         let case = common::symmetric_fe_case(seed, nx, ny, friction);
         let data = &case.data;
-        let omega = 50.0;
         let (a0, a1) = if oscillating {
-            (0.0, 4.0 * std::f64::consts::PI / omega)
+            (0.0, oscillating_load(&case).1)
         } else {
             (case.a0, case.a1)
         };
@@ -509,15 +517,7 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
                 .build()
                 .expect("problem");
             let load = if oscillating {
-                let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
-                    w[0] = 1.0;
-                    w[1] = 2.0 * (omega * a).sin();
-                    dw[0] = 0.0;
-                    dw[1] = 2.0 * omega * (omega * a).cos();
-                    Ok::<(), fricont::load::LoadFailure>(())
-                };
-                let fs = vec![data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec()];
-                fricont::Load::basis(fs, Box::new(weights)).expect("basis load")
+                oscillating_load(&case).0
             } else {
                 data.affine_load()
             };
