@@ -204,7 +204,7 @@ impl Path {
     /// positively homogeneous, so their classes are read off the solution of the
     /// directional contact problem `ḋ = W λ̇ ± q'` (the other nodes keep their class).
     #[allow(clippy::too_many_arguments)]
-    pub(super) fn continuations(
+    fn continuations(
         &self,
         pt: &Point,
         fixed: &[Class],
@@ -468,7 +468,6 @@ impl Path {
                 )?);
                 if wider.len() == 1 {
                     cands = wider;
-                    first = None;
                     break;
                 }
                 if first.is_none() && !wider.is_empty() {
