@@ -194,6 +194,25 @@ struct GeneralEval {
     q: Vec<f64>,
     dq: Vec<f64>,
     q_lo: Option<Vec<f64>>,
+    /// `‖exact(B A⁻¹ f(α)) − q‖∞` (computed on first use, see [`BoundLoad::determination`]).
+    error: std::cell::OnceCell<Option<f64>>,
+}
+
+impl GeneralEval {
+    /// How far `q` is from the exact condensation of `f`: from the low part where W was
+    /// refined, else by the refinement of [`Delassus::condense_error`] (a few solves with
+    /// the factor of A). None where neither is possible.
+    fn error(&self, del: &Delassus) -> Option<f64> {
+        *self.error.get_or_init(|| match &self.q_lo {
+            Some(lo) => Some(inf_norm(lo)),
+            None => del
+                .condense_error(&[&self.f], &[&self.q])
+                .ok()
+                .flatten()
+                .and_then(|mut v| v.pop())
+                .map(|lo| inf_norm(&lo)),
+        })
+    }
 }
 
 impl BoundLoad {
@@ -315,28 +334,43 @@ impl BoundLoad {
 
     /// How far the data determine each row of `q(α)`: `Σ_j |w_j(α)| ‖δq_j‖∞`
     /// ([`Self::condensation_errors`], about κ(A) ε ‖q_j‖∞ in every row; the weights as in
-    /// [`Self::term_magnitude_rows`]). Perturbing A by its own rounding (an element matrix
-    /// whose entries that are equal by symmetry came out of different sums) moves q by
-    /// about as much, so a row below it has no sign: on a mirror-symmetric body, the node
-    /// on the axis touched down with a tangential displacement of 1.6e-14 of the load's
-    /// scale where it is 0 by symmetry, and no class fitted it. None where not known. Used
-    /// only where the usual thresholds find no continuation, or several (the latest
-    /// weights of a basis load stand in for α's where those are no longer at hand).
+    /// [`Self::term_magnitude_rows`]); for a general load evaluated last at α, the error of
+    /// that evaluation's q ([`GeneralEval::error`]). Perturbing A by its own rounding (an
+    /// element matrix whose entries that are equal by symmetry came out of different sums)
+    /// moves q by about as much, so a row below it has no sign: on a mirror-symmetric
+    /// body, the node on the axis touched down with a tangential displacement of 1.6e-14
+    /// of the load's scale where it is 0 by symmetry, and no class fitted it. None where
+    /// not known. Used only where the usual thresholds find no continuation, or several
+    /// (the latest weights of a basis load stand in for α's where those are no longer at
+    /// hand).
     pub(crate) fn determination(&self, alpha: f64, del: &Delassus) -> Option<f64> {
+        if let Load::General { .. } = self.load {
+            return self.general_at(alpha)?.error(del);
+        }
         let w = self.abs_weights(alpha, true)?;
         let e = self.condensation_errors(del)?;
         Some(w.iter().zip(e).map(|(a, b)| a * b).sum())
     }
 
     /// `max_j ‖δq_j‖∞ / ‖q_j‖∞` ([`Self::condensation_errors`]): the relative error of the
-    /// condensation in double, about κ(A) ε. None where not known.
-    pub(crate) fn relative_determination(&self, del: &Delassus) -> Option<f64> {
+    /// condensation in double, about κ(A) ε; for a general load evaluated last at α, its
+    /// q's error relative to ‖q‖∞. None where not known.
+    pub(crate) fn relative_determination(&self, alpha: f64, del: &Delassus) -> Option<f64> {
+        if let Load::General { .. } = self.load {
+            let e = self.general_at(alpha)?;
+            return Some(e.error(del)? / inf_norm(&e.q)).filter(|r| r.is_finite());
+        }
         self.condensation_errors(del)?
             .iter()
             .zip(&self.q_basis)
             .map(|(e, q)| e / inf_norm(q))
             .filter(|r| r.is_finite())
             .reduce(f64::max)
+    }
+
+    /// A general load's last evaluation if it was at `alpha`.
+    fn general_at(&self, alpha: f64) -> Option<&GeneralEval> {
+        self.last_general.as_ref().filter(|e| e.alpha == alpha)
     }
 
     /// `(q0_lo, q1_lo)`: the low parts of the condensed affine load `q(α) = q0 + α q1`
@@ -610,6 +644,7 @@ impl BoundLoad {
                     q: q.clone(),
                     dq: dq.clone(),
                     q_lo,
+                    error: std::cell::OnceCell::new(),
                 });
                 Ok((q, dq))
             }

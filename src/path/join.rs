@@ -24,7 +24,8 @@ impl Path {
     /// of them 4, 16 and 64 times wider, as far as κ(W) times the relative error of the
     /// condensation ([`crate::load::BoundLoad::relative_determination`], about κ(A) ε)
     /// exceeds `zero_tol` (the forces are undetermined by that much). Empty where none of
-    /// this is known (a general load, a host's solve, condensed input).
+    /// this is known (a host's solve, condensed input, a general load not evaluated at
+    /// `pt` last).
     fn widening(&self, pt: &Point) -> Vec<(f64, f64)> {
         let del = self.problem.delassus();
         let Some(det) = self.load.determination(pt.alpha, del) else {
@@ -33,9 +34,12 @@ impl Path {
         let min_row = 2.0 * self.problem.default_r() * det;
         let mut out = vec![(1.0, min_row)];
         if !self.problem.extended_precision() {
-            let bound = self.load.relative_determination(del).map_or(1.0, |rho| {
-                self.problem.w_condition_estimate() * rho / self.opts.zero_tol
-            });
+            let bound = self
+                .load
+                .relative_determination(pt.alpha, del)
+                .map_or(1.0, |rho| {
+                    self.problem.w_condition_estimate() * rho / self.opts.zero_tol
+                });
             let mut k = 4.0;
             while k <= bound.min(MAX_WIDENING) {
                 out.push((k, min_row));
