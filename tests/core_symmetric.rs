@@ -518,6 +518,9 @@ fn mirror_symmetric_bodies_in_double_precision() {
 /// - 401 nodes, F = 0.1: the node on the axis, lifting off, reaches its stick cone 3.6e-11
 ///   of the forces before λ = 0 (its λt is rounding there), and slip either way fits: a
 ///   bifurcation at the usual thresholds, where the path stopped; the node lifts off;
+/// - 401 nodes, F = 5, under the oscillating load: a mirrored node fits no class at all at
+///   the usual thresholds (the error "fits no class" was returned before the widened ones
+///   were tried);
 /// - 61 and 201 nodes under the oscillating load given as a general load (q condensed at
 ///   every α, so how far the data determine it is that evaluation's own error): the node
 ///   on the axis touches down and no piece continued the path.
@@ -540,6 +543,7 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
         (35, 161, 4, 0.8, Affine),
         (51, 301, 2, 5.0, Oscillating),
         (55, 400, 1, 0.1, Affine),
+        (51, 400, 1, 5.0, Oscillating),
         (68, 60, 4, 0.3, OscillatingGeneral),
         (53, 200, 2, 0.8, OscillatingGeneral),
     ] {

@@ -384,8 +384,19 @@ impl Path {
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
         let usual = (1.0, 0.0);
         let mut blockers = Vec::new();
-        let mut cands =
-            self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, usual)?;
+        // A node that fits no class at the usual thresholds may fit one at the widened
+        // ones below: the error is returned only where those find no continuation either.
+        let (mut cands, mut unfit) = match self.continuations_either(
+            &pt,
+            &cur.classes,
+            &nodes,
+            back,
+            &mut blockers,
+            usual,
+        ) {
+            Ok(cands) => (cands, None),
+            Err(e) => (Vec::new(), Some(e)),
+        };
         // A node that the way in found clear of zero (its guard crossing a step beyond
         // `zero_tol` along the old piece) may be at zero and leaving along every
         // neighbouring piece: it switches here too. Transitions a rounding apart look like
@@ -462,14 +473,20 @@ impl Path {
         if cands.len() != 1 {
             let mut first = None;
             for widen in self.widening(&pt) {
-                let wider = without_retrace(self.continuations_either(
+                let wider = match self.continuations_either(
                     &pt,
                     &cur.classes,
                     &nodes,
                     back,
                     &mut blockers,
                     widen,
-                )?);
+                ) {
+                    Ok(wider) => without_retrace(wider),
+                    Err(e) => {
+                        unfit.get_or_insert(e);
+                        continue;
+                    }
+                };
                 if wider.len() == 1 {
                     cands = wider;
                     break;
@@ -488,6 +505,9 @@ impl Path {
             (tr.events.len(), tr.pieces.len(), tr.last_dir, tr.sigma)
         };
         if cands.is_empty() {
+            if let Some(e) = unfit {
+                return Err(e);
+            }
             return Err(Error::Numerical(format!(
                 "no neighbouring piece continues the path at alpha = {:e} (nodes {:?}){}",
                 pt.alpha,
