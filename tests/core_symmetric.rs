@@ -523,7 +523,12 @@ fn mirror_symmetric_bodies_in_double_precision() {
 ///   were tried);
 /// - 61 and 201 nodes under the oscillating load given as a general load (q condensed at
 ///   every α, so how far the data determine it is that evaluation's own error): the node
-///   on the axis touches down and no piece continued the path.
+///   on the axis touches down and no piece continued the path;
+/// - 151 nodes, F = 0.1, under the oscillating load: the node on the axis touches down with
+///   a tangential displacement below what the data determine but above the usual
+///   threshold, so that slip fitted and stick did not (a unique continuation at the usual
+///   thresholds): it slipped for 2e-12 in α before it stuck, two events for one, the
+///   second flagged as a bifurcation.
 ///
 /// Each must give the events of the trace refined to double-double
 /// ([`fricont::ExtendedPrecision::On`]; under the basis load where the double trace's is
@@ -546,6 +551,7 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
         (51, 400, 1, 5.0, Oscillating),
         (68, 60, 4, 0.3, OscillatingGeneral),
         (53, 200, 2, 0.8, OscillatingGeneral),
+        (4, 150, 1, 0.1, Oscillating),
     ] {
         let ctx = format!("seed {seed} (nx = {nx}, ny = {ny}, F = {friction}, {kind:?})");
         let case = common::symmetric_fe_case(seed, nx, ny, friction);

@@ -17,6 +17,11 @@ const RETRACE_LOOKBACK: usize = 4;
 /// apart).
 const ROUNDING_LONG: f64 = 1e-8;
 
+/// A bound on how far the data determine q, relative to the load's terms
+/// ([`Path::undetermined_fit`]): the condensation's relative error, about κ(A) ε, is below
+/// it wherever A is well enough conditioned for double.
+const DETERMINATION_BOUND: f64 = 1e-8;
+
 impl Path {
     /// `transit`'s last-resort thresholds at `pt`, as arguments of [`Tol::widened`]: first
     /// no displacement row's below twice how far the data determine q's rows
@@ -47,6 +52,22 @@ impl Path {
             }
         }
         out
+    }
+
+    /// The first of [`Self::widening`] at `pt` where it changes the classes some node of
+    /// `nodes` fits (else None). How far the data determine q costs a few solves with A
+    /// (once per path), so it is found only where a bound on it changes them: no
+    /// displacement row's threshold below [`DETERMINATION_BOUND`] of the load's terms.
+    fn undetermined_fit(&self, pt: &Point, nodes: &[usize]) -> Option<(f64, f64)> {
+        let tol = self.tol_at(pt);
+        let usual = self.compatible(nodes, pt, &tol);
+        let r0 = self.problem.default_r();
+        let bound = 2.0 * r0 * DETERMINATION_BOUND * inf_norm(&self.term_rows(pt));
+        if self.compatible(nodes, pt, &tol.clone().widened((1.0, bound))) == usual {
+            return None;
+        }
+        let widen = *self.widening(pt).first()?;
+        (self.compatible(nodes, pt, &tol.widened(widen)) != usual).then_some(widen)
     }
 
     /// Classes of each node in `nodes` whose equations and guards hold at the point (to
@@ -456,6 +477,25 @@ impl Path {
             cands
         };
         cands = without_retrace(cands);
+        // A single continuation at the usual thresholds that the data do not determine: a
+        // switching node fits other classes where no displacement row's threshold is
+        // below how far the data determine q (the first of `widening`). On a
+        // mirror-symmetric body in double, the node on the axis touched down with a
+        // tangential displacement of 1e-14 of the load's scale (0 by symmetry): stick did
+        // not fit and slip did, and the path slipped for 2e-12 in α before it stuck (two
+        // events for one, the second flagged as a bifurcation). There the widened
+        // thresholds block slip (its guard is at zero and leaving) and take stick: where
+        // they find exactly one continuation, it is taken.
+        if cands.len() == 1
+            && let Some(widen) = self.undetermined_fit(&pt, &nodes)
+            && let Ok(wider) =
+                self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, widen)
+        {
+            let wider = without_retrace(wider);
+            if wider.len() == 1 {
+                cands = wider;
+            }
+        }
         // The last resort where the usual thresholds find no continuation or several, as
         // the data may determine the point less well than they assume (`widening`): no
         // displacement row's threshold below how far the data determine q's rows, then
