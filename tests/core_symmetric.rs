@@ -528,7 +528,10 @@ fn mirror_symmetric_bodies_in_double_precision() {
 ///   a tangential displacement below what the data determine but above the usual
 ///   threshold, so that slip fitted and stick did not (a unique continuation at the usual
 ///   thresholds): it slipped for 2e-12 in α before it stuck, two events for one, the
-///   second flagged as a bifurcation.
+///   second flagged as a bifurcation;
+/// - 201 nodes, F = 5: the two end nodes, slipping, lift off together; one reaches λ = 0
+///   and its image is left with λν at 0.84 of its threshold and λt = 5 λν, beyond it, so
+///   that open did not fit it and no piece continued the path.
 ///
 /// Each must give the events of the trace refined to double-double
 /// ([`fricont::ExtendedPrecision::On`]; under the basis load where the double trace's is
@@ -552,6 +555,7 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
         (68, 60, 4, 0.3, OscillatingGeneral),
         (53, 200, 2, 0.8, OscillatingGeneral),
         (4, 150, 1, 0.1, Oscillating),
+        (235, 200, 1, 5.0, Affine),
     ] {
         let ctx = format!("seed {seed} (nx = {nx}, ny = {ny}, F = {friction}, {kind:?})");
         let case = common::symmetric_fe_case(seed, nx, ny, friction);

@@ -23,50 +23,69 @@ const ROUNDING_LONG: f64 = 1e-8;
 const DETERMINATION_BOUND: f64 = 1e-8;
 
 impl Path {
+    /// No displacement row's threshold below twice how far the data determine q's rows
+    /// ([`crate::load::BoundLoad::determination`], in force units). None where that is not
+    /// known (a host's solve, condensed input, a general load not evaluated at `pt` last).
+    fn determined(&self, pt: &Point) -> Option<Widen> {
+        let det = self.load.determination(pt.alpha, self.problem.delassus())?;
+        Some(Widen {
+            min_row: 2.0 * self.problem.default_r() * det,
+            ..Widen::USUAL
+        })
+    }
+
     /// `transit`'s last-resort thresholds at `pt`, as arguments of [`Tol::widened`]: first
-    /// no displacement row's below twice how far the data determine q's rows
-    /// ([`crate::load::BoundLoad::determination`], in force units); then, in double, all
-    /// of them 4, 16 and 64 times wider, as far as κ(W) times the relative error of the
-    /// condensation ([`crate::load::BoundLoad::relative_determination`], about κ(A) ε)
-    /// exceeds `zero_tol` (the forces are undetermined by that much). Empty where none of
-    /// this is known (a host's solve, condensed input, a general load not evaluated at
-    /// `pt` last).
-    fn widening(&self, pt: &Point) -> Vec<(f64, f64)> {
-        let del = self.problem.delassus();
-        let Some(det) = self.load.determination(pt.alpha, del) else {
-            return Vec::new();
+    /// [`Self::determined`]; then, in double, all of them 4, 16 and 64 times wider, as far
+    /// as κ(W) times the relative error of the condensation
+    /// ([`crate::load::BoundLoad::relative_determination`], about κ(A) ε) exceeds
+    /// `zero_tol` (the forces are undetermined by that much); last, the first with
+    /// [`Widen::cone`] (alone where the determination is not known).
+    fn widening(&self, pt: &Point) -> Vec<Widen> {
+        let Some(first) = self.determined(pt) else {
+            return vec![Widen {
+                cone: true,
+                ..Widen::USUAL
+            }];
         };
-        let min_row = 2.0 * self.problem.default_r() * det;
-        let mut out = vec![(1.0, min_row)];
+        let mut out = vec![first];
         if !self.problem.extended_precision() {
             let bound = self
                 .load
-                .relative_determination(pt.alpha, del)
+                .relative_determination(pt.alpha, self.problem.delassus())
                 .map_or(1.0, |rho| {
                     self.problem.w_condition_estimate() * rho / self.opts.zero_tol
                 });
             let mut k = 4.0;
             while k <= bound.min(MAX_WIDENING) {
-                out.push((k, min_row));
+                out.push(Widen { k, ..first });
                 k *= 4.0;
             }
         }
+        out.push(Widen {
+            cone: true,
+            ..first
+        });
         out
     }
 
-    /// The first of [`Self::widening`] at `pt` where it changes the classes some node of
-    /// `nodes` fits (else None). How far the data determine q costs a few solves with A
-    /// (once per path), so it is found only where a bound on it changes them: no
-    /// displacement row's threshold below [`DETERMINATION_BOUND`] of the load's terms.
-    fn undetermined_fit(&self, pt: &Point, nodes: &[usize]) -> Option<(f64, f64)> {
+    /// [`Self::determined`] at `pt` where it changes the classes some node of `nodes` fits
+    /// (else None). How far the data determine q costs a few solves with A (once per
+    /// path), so it is found only where a bound on it changes them: no displacement row's
+    /// threshold below [`DETERMINATION_BOUND`] of the load's terms.
+    fn undetermined_fit(&self, pt: &Point, nodes: &[usize]) -> Option<Widen> {
         let tol = self.tol_at(pt);
         let usual = self.compatible(nodes, pt, &tol);
-        let r0 = self.problem.default_r();
-        let bound = 2.0 * r0 * DETERMINATION_BOUND * inf_norm(&self.term_rows(pt));
-        if self.compatible(nodes, pt, &tol.clone().widened((1.0, bound))) == usual {
+        let bound = Widen {
+            min_row: 2.0
+                * self.problem.default_r()
+                * DETERMINATION_BOUND
+                * inf_norm(&self.term_rows(pt)),
+            ..Widen::USUAL
+        };
+        if self.compatible(nodes, pt, &tol.clone().widened(bound)) == usual {
             return None;
         }
-        let widen = *self.widening(pt).first()?;
+        let widen = self.determined(pt)?;
         (self.compatible(nodes, pt, &tol.widened(widen)) != usual).then_some(widen)
     }
 
@@ -87,7 +106,7 @@ impl Path {
         Class::ALL
             .into_iter()
             .filter(|&cl| {
-                let eq_ok = c.equations(i, cl).iter().all(|e| {
+                let eq_ok = c.equations(i, cl).iter().enumerate().all(|(k, e)| {
                     // equations in force units: displacement rows scaled by r0 instead of r
                     let [a0, a1] = e.lam;
                     let v = a0.coef * lam[a0.index]
@@ -97,7 +116,8 @@ impl Path {
                         } else {
                             0.0
                         };
-                    v.abs() <= tol.of(e)
+                    v.abs()
+                        <= tol.of(e) * tol.cone_factor(cl == Class::Open && k == 1, c.friction[i])
                 });
                 eq_ok
                     && crate::piece::guard_kinds(cl).iter().all(|&kind| {
@@ -237,7 +257,7 @@ impl Path {
         back: Option<(&[Class], &[f64])>,
         relaxed: bool,
         blockers: &mut Vec<usize>,
-        widen: (f64, f64),
+        widen: Widen,
     ) -> Result<Vec<Candidate>> {
         let scale = self.force_scale(pt);
         // A start (no way in) is a point of the fixed-α solver, known to its accuracy.
@@ -331,7 +351,7 @@ impl Path {
         nodes: &[usize],
         back: Option<(&[Class], &[f64])>,
         blockers: &mut Vec<usize>,
-        widen: (f64, f64),
+        widen: Widen,
     ) -> Result<Vec<Candidate>> {
         let cands = self.continuations(pt, fixed, nodes, back, false, blockers, widen)?;
         if !cands.is_empty() {
@@ -403,7 +423,7 @@ impl Path {
         let entry = self.point_at(cur.lam.clone(), cur.alpha)?;
         let pt = self.snap_to_vertex(pt, &tol, &entry)?;
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
-        let usual = (1.0, 0.0);
+        let usual = Widen::USUAL;
         let mut blockers = Vec::new();
         // A node that fits no class at the usual thresholds may fit one at the widened
         // ones below: the error is returned only where those find no continuation either.
@@ -500,7 +520,10 @@ impl Path {
         // the data may determine the point less well than they assume (`widening`): no
         // displacement row's threshold below how far the data determine q's rows, then
         // all thresholds 4, 16, 64 times wider as far as the forces are undetermined (in
-        // double only). The first that finds exactly one continuation is taken; else what
+        // double only), last an open node's λt against F times its threshold (its λν is
+        // at zero to its threshold, and |λt| ≤ F λν: with F = 5 a slipping node lifting
+        // off with its mirror image, λν at 0.84 of its threshold, did not fit open). The
+        // first that finds exactly one continuation is taken; else what
         // the usual thresholds found, or, where they found none, the first that finds any.
         // On mirror-symmetric bodies, whose W and q are symmetric to about κ(A) ε only:
         // the node on the axis touched down with a tangential displacement of 1.6e-14 of

@@ -316,6 +316,34 @@ pub(super) struct Tol {
     /// otherwise).
     widen: f64,
     min_row: f64,
+    /// An open node's `λt = 0` judged against `max(1, F_i)` times its threshold
+    /// ([`Widen::cone`]; false otherwise).
+    cone: bool,
+}
+
+/// How the thresholds of `join::transit`'s retries differ from the usual ones
+/// ([`Tol::widened`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Widen {
+    /// Factor on every threshold (and on `arc`).
+    pub k: f64,
+    /// No displacement row's threshold below this (force units).
+    pub min_row: f64,
+    /// An open node's `λt = 0` judged against `max(1, F_i)` times its threshold. A node
+    /// leaving contact has `|λt| ≤ F λν`, so where `λν` is at zero to its threshold, `λt`
+    /// is at zero to F times it: a slipping node (F = 5) lifting off with its mirror image
+    /// had λν = 4.6e-15 against a threshold of 5.4e-15 and λt = 2.3e-14, and open did
+    /// not fit it.
+    pub cone: bool,
+}
+
+impl Widen {
+    /// The usual thresholds.
+    pub const USUAL: Widen = Widen {
+        k: 1.0,
+        min_row: 0.0,
+        cone: false,
+    };
 }
 
 /// The rounding of a guard's value at an exactly computed point, as a fraction of
@@ -372,6 +400,7 @@ impl Tol {
             rounding: 1.0,
             widen: 1.0,
             min_row: 0.0,
+            cone: false,
         }
     }
 
@@ -382,16 +411,27 @@ impl Tol {
         self
     }
 
-    /// Every threshold (and `arc`) times `k`, and no displacement row's below `min_row`
-    /// (force units): see `join::transit`, the last resort where no neighbouring piece
-    /// continues the path.
-    pub(super) fn widened(mut self, (k, min_row): (f64, f64)) -> Self {
-        self.force *= k;
-        self.disp *= k;
-        self.arc *= k;
-        self.widen *= k;
-        self.min_row = self.min_row.max(min_row);
+    /// Every threshold (and `arc`) times `k`, no displacement row's below `min_row`
+    /// (force units), and open nodes' `λt` as [`Widen::cone`] says: see `join::transit`,
+    /// the last resort where no neighbouring piece continues the path.
+    pub(super) fn widened(mut self, w: Widen) -> Self {
+        self.force *= w.k;
+        self.disp *= w.k;
+        self.arc *= w.k;
+        self.widen *= w.k;
+        self.min_row = self.min_row.max(w.min_row);
+        self.cone |= w.cone;
         self
+    }
+
+    /// The factor on the threshold of an open node's `λt = 0` (`open_t`) at a node of
+    /// friction coefficient `friction`: `max(1, F)` where [`Widen::cone`] is set, else 1.
+    pub(super) fn cone_factor(&self, open_t: bool, friction: f64) -> f64 {
+        if self.cone && open_t {
+            friction.max(1.0)
+        } else {
+            1.0
+        }
     }
 
     /// The threshold for the derivative of a form along a unit tangent (scaled
@@ -841,6 +881,7 @@ impl Path {
             rounding: ROUNDING,
             widen: 1.0,
             min_row: 0.0,
+            cone: false,
         };
         self.tol_cache.put(pt.alpha, &pt.lam, tol.clone());
         tol
@@ -1410,7 +1451,7 @@ impl Path {
         }
         let want = sign(self.opts.alpha_end - self.opts.alpha_start);
         let cands =
-            self.continuations_either(&pt, &fixed, &nodes, None, &mut Vec::new(), (1.0, 0.0))?;
+            self.continuations_either(&pt, &fixed, &nodes, None, &mut Vec::new(), Widen::USUAL)?;
         let ms = 2 * p;
         let toward: Vec<usize> = (0..cands.len())
             .filter(|&k| cands[k].direction() == want)
