@@ -6,7 +6,7 @@ use super::advance::GuardRow;
 use super::*;
 
 /// The widest of `transit`'s last-resort thresholds, as a multiple of the usual ones.
-const MAX_WIDENING: f64 = 64.0;
+pub(super) const MAX_WIDENING: f64 = 64.0;
 
 /// The pieces before the current one that `transit` compares a candidate with (a way back
 /// along one of them, across pieces a rounding long, is not a branch).

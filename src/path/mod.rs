@@ -425,10 +425,14 @@ impl Tol {
     }
 
     /// The factor on the threshold of an open node's `λt = 0` (`open_t`) at a node of
-    /// friction coefficient `friction`: `max(1, F)` where [`Widen::cone`] is set, else 1.
+    /// (equilibrated) friction coefficient `friction`: `F` between 1 and the retries'
+    /// widest factor ([`join::MAX_WIDENING`]) where [`Widen::cone`] is set, else 1. Beyond
+    /// that, F times a threshold is no longer rounding: with a node's tangential row 1e300
+    /// times its normal one (F 1e300 times larger once equilibrated), open fitted a node
+    /// whose λt was not zero, and the event's residual was 1.7e-3.
     pub(super) fn cone_factor(&self, open_t: bool, friction: f64) -> f64 {
         if self.cone && open_t {
-            friction.max(1.0)
+            friction.clamp(1.0, join::MAX_WIDENING)
         } else {
             1.0
         }
