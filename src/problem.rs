@@ -982,9 +982,11 @@ fn equilibrated_w(w: Mat<f64>) -> Result<(Mat<f64>, Vec<f64>, Mat<f64>)> {
 
 /// Node i's friction coefficient for the equilibrated rows: `F_i s_{p+i} / s_i` (exact:
 /// the scales are powers of two), so that `|λt| ≤ F λν` in the caller's units is the same
-/// cone for the internal forces `s λ`. Error where it leaves the range of doubles (a node
-/// whose tangential and normal rows differ in length by a factor near 1e308, or a
-/// friction coefficient near the largest double).
+/// cone for the internal forces `s λ`. Error where it leaves the range of normal doubles (a
+/// node whose tangential and normal rows differ in length by a factor near 1e308, or a
+/// friction coefficient near the largest double): a subnormal coefficient keeps only some
+/// of F's digits (a tangential row of one entry 1e-320 gave slipping nodes |λt| = 1.15 F
+/// |λν| in the caller's units).
 fn equilibrated_friction(friction: &[f64], row_scale: &[f64]) -> Result<Vec<f64>> {
     let p = friction.len();
     (0..p)
@@ -992,11 +994,11 @@ fn equilibrated_friction(friction: &[f64], row_scale: &[f64]) -> Result<Vec<f64>
             // the scales are powers of two: their log2 are exact integers
             let e = row_scale[p + i].log2() as i32 - row_scale[i].log2() as i32;
             let f = mul_pow2(friction[i], e);
-            if f.is_finite() && (f > 0.0 || friction[i] == 0.0) {
+            if f.is_finite() && (f >= f64::MIN_POSITIVE || friction[i] == 0.0) {
                 Ok(f)
             } else {
                 Err(Error::InvalidParameter(format!(
-                    "friction coefficient F = {:e} at node {}: F times the ratio 2^{e} of the node's tangential and normal row norms is out of the range of doubles",
+                    "friction coefficient F = {:e} at node {}: F times the ratio 2^{e} of the node's tangential and normal row norms is out of the range of normal doubles",
                     friction[i],
                     i + 1
                 )))

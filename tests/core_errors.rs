@@ -955,9 +955,10 @@ fn a_load_failing_ahead_is_reached_after_the_transitions_before_it() {
 }
 
 /// Each row of N and T is equilibrated by its own power of two, and node i's friction
-/// coefficient by their ratio (`F s_t / s_ν`): where that leaves the range of doubles (rows
-/// of 1e-300 and 1e300 at one node, ratio 2^1993) the build is an `InvalidParameter`
-/// naming the node; F = 0 and an F small enough for the ratio are accepted.
+/// coefficient by their ratio (`F s_t / s_ν`): where that leaves the range of normal
+/// doubles (rows of 1e-300 and 1e300 at one node, ratio 2^1993; or a tangential row of
+/// 1e-320 with F = 0.3) the build is an `InvalidParameter` naming the node; F = 0 and an F
+/// small (or large) enough for the ratio are accepted.
 #[test]
 fn friction_out_of_range_for_the_rows_of_its_node() {
     let apart = |f: f64| {
@@ -980,4 +981,24 @@ fn friction_out_of_range_for_the_rows_of_its_node() {
         let fe = p.friction_equilibrated()[0];
         assert!(fe.is_finite() && (fe > 0.0) == (f > 0.0), "{fe}");
     }
+    // A tangential row of 1e-320 (a subnormal number): 0.3 · 2^-1063 is subnormal and
+    // keeps only some of 0.3's digits (slipping nodes had |λt| = 1.15 F |λν| in the
+    // caller's units), so it is an error too; F = 1e300 gives a normal number, kept.
+    let tiny_t = |f: f64| {
+        ProblemBuilder::new(
+            dense(3, 3, &eye(3)),
+            Storage::Full,
+            dense(1, 3, &[1.0, 0.0, 0.0]),
+            dense(1, 3, &[0.0, 1e-320, 0.0]),
+        )
+        .friction_uniform(f)
+    };
+    let e = build_err("friction 0.3 on rows 1, 1e-320", tiny_t(0.3));
+    assert!(
+        matches!(e, Error::InvalidParameter(ref m) if m.contains("node 1") && m.contains("normal doubles")),
+        "{e}"
+    );
+    let p = no_panic("friction 1e300 on rows 1, 1e-320", || tiny_t(1e300).build()).unwrap();
+    let fe = p.friction_equilibrated()[0];
+    assert!(fe >= f64::MIN_POSITIVE && fe.is_finite(), "{fe}");
 }

@@ -975,8 +975,9 @@ pub unsafe extern "C" fn fricont_problem_extended_precision(
 /// (an r set outside [1e-6, 1e6] × the default 2p / trace(W); or A's largest entry a
 /// subnormal number below 2^-1034 ≈ 5.4e-312, fewer than 40 significant bits: multiply A
 /// and the loads by one power of two; or a friction coefficient F that, times the ratio of
-/// its node's tangential and normal row norms, leaves the range of doubles: rows whose
-/// lengths differ by a factor near 1e308), `FRICONT_ERR_NUMERICAL` (W = B A⁻¹ Bᵀ beyond the
+/// its node's tangential and normal row norms, leaves the range of normal doubles: rows
+/// whose lengths differ by a factor near 1e308, or a tangential row near 1e-308 of its
+/// normal one), `FRICONT_ERR_NUMERICAL` (W = B A⁻¹ Bᵀ beyond the
 /// range of a double: A numerically singular),
 /// `FRICONT_ERR_OUT_OF_MEMORY` (the factor, W or a copy of the data cannot be allocated:
 /// the message says how much was asked; the handle stays usable),
