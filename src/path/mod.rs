@@ -316,8 +316,8 @@ pub(super) struct Tol {
     /// otherwise).
     widen: f64,
     min_row: f64,
-    /// An open node's `λt = 0` judged against `max(1, F_i)` times its threshold
-    /// ([`Widen::cone`]; false otherwise).
+    /// An open node's `λt = 0` judged against F times its threshold ([`Widen::cone`],
+    /// [`Tol::cone_factor`]; false otherwise).
     cone: bool,
 }
 
@@ -329,11 +329,12 @@ pub(super) struct Widen {
     pub k: f64,
     /// No displacement row's threshold below this (force units).
     pub min_row: f64,
-    /// An open node's `λt = 0` judged against `max(1, F_i)` times its threshold. A node
-    /// leaving contact has `|λt| ≤ F λν`, so where `λν` is at zero to its threshold, `λt`
-    /// is at zero to F times it: a slipping node (F = 5) lifting off with its mirror image
-    /// had λν = 4.6e-15 against a threshold of 5.4e-15 and λt = 2.3e-14, and open did
-    /// not fit it.
+    /// An open node's `λt = 0` judged against `F_i` (clamped to [1, 64],
+    /// [`Tol::cone_factor`]) times its threshold. A node leaving contact has
+    /// `|λt| ≤ F λν`, so where `λν` is at zero to its threshold, `λt` is at zero to F
+    /// times it: a slipping node (F = 5) lifting off with its mirror image had
+    /// λν = 4.6e-15 against a threshold of 5.4e-15 and λt = 2.3e-14, and open did not
+    /// fit it.
     pub cone: bool,
 }
 
