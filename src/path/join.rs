@@ -499,7 +499,7 @@ impl Path {
         cands = without_retrace(cands);
         // A single continuation at the usual thresholds that the data do not determine: a
         // switching node fits other classes where no displacement row's threshold is
-        // below how far the data determine q (the first of `widening`). On a
+        // below how far the data determine q (`determined`). On a
         // mirror-symmetric body in double, the node on the axis touched down with a
         // tangential displacement of 1e-14 of the load's scale (0 by symmetry): stick did
         // not fit and slip did, and the path slipped for 2e-12 in α before it stuck (two

@@ -414,7 +414,8 @@ impl Tol {
 
     /// Every threshold (and `arc`) times `k`, no displacement row's below `min_row`
     /// (force units), and open nodes' `λt` as [`Widen::cone`] says: see `join::transit`,
-    /// the last resort where no neighbouring piece continues the path.
+    /// its retries where the usual thresholds find no continuation or several, or one that
+    /// the data do not determine.
     pub(super) fn widened(mut self, w: Widen) -> Self {
         self.force *= w.k;
         self.disp *= w.k;
