@@ -259,3 +259,40 @@ fn curved_foundations_and_corners_against_the_reference() {
         "{events} events, {folds} folds"
     );
 }
+
+/// Slender cantilevered strips (100–200 × 2–3 elements on 10 × 0.1 or 10 × 0.2, clamped
+/// at the left, F = 5) under the default options, against the independent tracer of
+/// `tests/common/reference.rs`: the same transitions at the same α to 1e-9, to the end of
+/// the window. On such a strip the rows of q differ by orders of magnitude (the free
+/// end's displacements are thousands of times those near the clamp). A node touching
+/// down near the clamp while sliding was reported as open → stick, where the reference
+/// has open → slip: the retries' floor on the displacement rows was the error of q's
+/// largest row, far above the node's own tangential displacement (one event missing on
+/// each of these four strips, without any error; two on one of them).
+#[test]
+fn slender_strips_against_the_reference() {
+    use common::reference::{Condensed, compare_with_fricont};
+    for (seed, nx, ny, ly) in [
+        (11u64, 100usize, 2usize, 0.1),
+        (3, 100, 3, 0.1),
+        (10, 150, 3, 0.2),
+        (4, 200, 3, 0.2),
+    ] {
+        let case = common::fe_strip(seed, nx, ny, 5.0, 10.0, ly);
+        let d = &case.data;
+        let c = compare_with_fricont(
+            &Condensed::from_data(d),
+            Arc::new(d.problem()),
+            d.f0.as_slice(),
+            d.f1.as_slice(),
+            -2.0,
+            2.0,
+            1e-9,
+            &mut |_, _| {},
+        );
+        let ctx = format!("seed {seed}, {nx} × {ny} elements on 10 × {ly}");
+        c.check(1e-9).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+        assert_eq!(c.fricont_end.1, "window", "{ctx}");
+        assert!(c.fricont.len() >= 80, "{ctx}: {} events", c.fricont.len());
+    }
+}

@@ -24,12 +24,17 @@ const DETERMINATION_BOUND: f64 = 1e-8;
 
 impl Path {
     /// No displacement row's threshold below twice how far the data determine q's rows
-    /// ([`crate::load::BoundLoad::determination`], in force units). None where that is not
-    /// known (a host's solve, condensed input, a general load not evaluated at `pt` last).
+    /// ([`crate::load::BoundLoad::determination`], in force units), nor that floor above
+    /// a few times the relative error of the condensation
+    /// ([`crate::load::BoundLoad::relative_determination`]) times the terms of the row's
+    /// node ([`Widen::determined`]). None where that is not known (a host's solve,
+    /// condensed input, a general load not evaluated at `pt` last).
     fn determined(&self, pt: &Point) -> Option<Widen> {
-        let det = self.load.determination(pt.alpha, self.problem.delassus())?;
+        let del = self.problem.delassus();
+        let det = self.load.determination(pt.alpha, del)?;
         Some(Widen {
             min_row: 2.0 * self.problem.default_r() * det,
+            determined: self.load.relative_determination(pt.alpha, del)?,
             ..Widen::USUAL
         })
     }
@@ -71,7 +76,8 @@ impl Path {
     /// [`Self::determined`] at `pt` where it changes the classes some node of `nodes` fits
     /// (else None). How far the data determine q costs a few solves with A (once per
     /// path), so it is found only where a bound on it changes them: no displacement row's
-    /// threshold below [`DETERMINATION_BOUND`] of the load's terms.
+    /// threshold below [`DETERMINATION_BOUND`] of the load's terms (nor that above a few
+    /// times it of its node's terms).
     fn undetermined_fit(&self, pt: &Point, nodes: &[usize]) -> Option<Widen> {
         let tol = self.tol_at(pt);
         let usual = self.compatible(nodes, pt, &tol);
@@ -80,6 +86,7 @@ impl Path {
                 * self.problem.default_r()
                 * DETERMINATION_BOUND
                 * inf_norm(&self.term_rows(pt)),
+            determined: DETERMINATION_BOUND,
             ..Widen::USUAL
         };
         if self.compatible(nodes, pt, &tol.clone().widened(bound)) == usual {

@@ -312,10 +312,11 @@ pub(super) struct Tol {
     /// [`ROUNDING`] at a point found exactly (a transition point), 1 at a point of the
     /// fixed-α solver (a start), which is accurate to its 1e-12 only.
     rounding: f64,
-    /// Factor on the per-row thresholds and a floor under them ([`Tol::widened`]; 1 and 0
-    /// otherwise).
+    /// Factor on the per-row thresholds, and the floor under them ([`Widen::min_row`],
+    /// [`Widen::determined`], [`TolRows::floor_with`]); 1, 0 and 0 otherwise.
     widen: f64,
     min_row: f64,
+    determined: f64,
     /// An open node's `λt = 0` judged against F times its threshold ([`Widen::cone`],
     /// [`Tol::cone_factor`]; false otherwise).
     cone: bool,
@@ -327,8 +328,18 @@ pub(super) struct Tol {
 pub(super) struct Widen {
     /// Factor on every threshold (and on `arc`).
     pub k: f64,
-    /// No displacement row's threshold below this (force units).
+    /// A floor under every displacement row's threshold (force units): twice how far the
+    /// data determine q in the whole vector (its error's largest row).
     pub min_row: f64,
+    /// How far the data determine q (and W), relative to the terms of each row (about
+    /// κ(A) ε): no displacement row's floor above a few times that of the larger of its
+    /// node's two rows ([`TolRows::floor_with`]). The rows of q on a slender body differ
+    /// by orders of magnitude (on a cantilevered strip of 1000 contact nodes, |q| was
+    /// 4.6e3 at the free end and 7 near the clamp), and `min_row` alone made a node
+    /// touching down near the clamp with a tangential displacement of 5e-5 fit stick:
+    /// the path stuck, and stopped there; on smaller strips it reported open → stick
+    /// where the node slips first, without an error.
+    pub determined: f64,
     /// An open node's `λt = 0` judged against `F_i` (clamped to [1, 64],
     /// [`Tol::cone_factor`]) times its threshold. A node leaving contact has
     /// `|λt| ≤ F λν`, so where `λν` is at zero to its threshold, `λt` is at zero to F
@@ -343,6 +354,7 @@ impl Widen {
     pub const USUAL: Widen = Widen {
         k: 1.0,
         min_row: 0.0,
+        determined: 0.0,
         cone: false,
     };
 }
@@ -358,37 +370,78 @@ pub(super) struct TolRows {
     problem: Arc<Problem>,
     /// `zero_tol · r0`.
     factor: f64,
+    r0: f64,
+    /// `|q_k|ₜ` per row (the magnitude of the terms of `q_k(α)`).
+    terms: Vec<f64>,
     /// `|q_k|ₜ + |g_k|` per row.
     base: Vec<f64>,
     abs_lam: Vec<f64>,
     lam_max: f64,
     floor: f64,
-    /// The thresholds found so far, as f64 bits (NaN: not yet).
-    exact: Vec<std::sync::atomic::AtomicU64>,
+    /// `(|W| |λ|)_k` found so far, as f64 bits (NaN: not yet).
+    wl: Vec<std::sync::atomic::AtomicU64>,
 }
 
 impl TolRows {
-    fn exact(&self, k: usize) -> f64 {
+    /// `(|W| |λ|)_k`: one pass over row k of the symmetric W, read as its contiguous
+    /// column k (once per row).
+    fn wl(&self, k: usize) -> f64 {
         use std::sync::atomic::Ordering::Relaxed;
-        let v = f64::from_bits(self.exact[k].load(Relaxed));
+        let v = f64::from_bits(self.wl[k].load(Relaxed));
         if !v.is_nan() {
             return v;
         }
-        // Row k of the symmetric W, read as its contiguous column k.
         let w = self.problem.delassus().w();
         let col = w.col(k).try_as_col_major().expect("contiguous column");
-        let wl = crate::dense::abs_dot(col.as_slice(), &self.abs_lam);
-        let v = (self.factor * (self.base[k] + wl)).max(self.floor);
-        self.exact[k].store(v.to_bits(), Relaxed);
+        let v = crate::dense::abs_dot(col.as_slice(), &self.abs_lam);
+        self.wl[k].store(v.to_bits(), Relaxed);
         v
     }
 
-    /// An upper bound of [`Self::exact`] in O(1): `(|W||λ|)_k ≤ (|W| 1)_k ‖λ‖∞`.
+    fn exact(&self, k: usize) -> f64 {
+        (self.factor * (self.base[k] + self.wl(k))).max(self.floor)
+    }
+
+    /// An upper bound of `(|W||λ|)_k` in O(1): `(|W| 1)_k ‖λ‖∞`.
+    fn wl_upper(&self, k: usize) -> f64 {
+        self.problem.w_row_sums()[k] * self.lam_max
+    }
+
+    /// An upper bound of [`Self::exact`] in O(1).
     fn upper(&self, k: usize) -> f64 {
-        let row_sum = self.problem.w_row_sums()[k];
-        (self.factor * (self.base[k] + row_sum * self.lam_max)).max(self.floor)
+        (self.factor * (self.base[k] + self.wl_upper(k))).max(self.floor)
+    }
+
+    /// The floor under row k's threshold ([`Widen::min_row`], [`Widen::determined`]):
+    /// `min_row`, but not above [`DETERMINED_FACTOR`] `· r0 · determined ·` the larger
+    /// of `|q_j|ₜ + (|W| |λ|)_j` over the two rows j of k's node (a node's tangential row
+    /// can vanish by symmetry where its normal one does not, and its rounding is as
+    /// large). With `wl` = [`Self::wl_upper`]: a bound in O(1).
+    fn floor_with(
+        &self,
+        k: usize,
+        min_row: f64,
+        determined: f64,
+        wl: impl Fn(usize) -> f64,
+    ) -> f64 {
+        if min_row == 0.0 || determined == 0.0 {
+            return min_row;
+        }
+        let p = self.terms.len() / 2;
+        let other = if k < p { k + p } else { k - p };
+        let row = |j: usize| self.terms[j] + wl(j);
+        min_row.min(DETERMINED_FACTOR * self.r0 * determined * row(k).max(row(other)))
     }
 }
+
+/// The factor of [`TolRows::floor_with`]. On a mirror-symmetric body in double, the node
+/// on the axis touched down with a tangential displacement (0 by symmetry) of 3.1 times
+/// `r0 · determined ·` its normal row's terms: the data's own asymmetry (the element
+/// matrices of mirrored elements, summed in different orders) moves q by more than the
+/// error of the solve that measures `determined`. On a cantilevered strip, a node touching
+/// down near the clamp slid with a tangential displacement 1000 times it: that must stay
+/// determined.
+const DETERMINED_FACTOR: f64 = 8.0;
 
 impl Tol {
     /// One threshold for every form.
@@ -401,6 +454,7 @@ impl Tol {
             rounding: 1.0,
             widen: 1.0,
             min_row: 0.0,
+            determined: 0.0,
             cone: false,
         }
     }
@@ -412,8 +466,9 @@ impl Tol {
         self
     }
 
-    /// Every threshold (and `arc`) times `k`, no displacement row's below `min_row`
-    /// (force units), and open nodes' `λt` as [`Widen::cone`] says: see `join::transit`,
+    /// Every threshold (and `arc`) times `k`, no displacement row's below the floor of
+    /// [`Widen::min_row`] and [`Widen::determined`], and open nodes' `λt` as
+    /// [`Widen::cone`] says: see `join::transit`,
     /// its retries where the usual thresholds find no continuation or several, or one that
     /// the data do not determine.
     pub(super) fn widened(mut self, w: Widen) -> Self {
@@ -422,6 +477,7 @@ impl Tol {
         self.arc *= w.k;
         self.widen *= w.k;
         self.min_row = self.min_row.max(w.min_row);
+        self.determined = self.determined.max(w.determined);
         self.cone |= w.cone;
         self
     }
@@ -449,10 +505,11 @@ impl Tol {
     /// The threshold for a linear form.
     fn of(&self, f: &crate::piece::LinForm) -> f64 {
         if f.disp.coef != 0.0 {
-            self.rows
-                .as_ref()
-                .map_or(self.disp, |r| self.widen * r.exact(f.disp.index))
-                .max(self.min_row)
+            let k = f.disp.index;
+            self.rows.as_ref().map_or(self.disp.max(self.min_row), |r| {
+                let floor = r.floor_with(k, self.min_row, self.determined, |j| r.wl(j));
+                (self.widen * r.exact(k)).max(floor)
+            })
         } else {
             self.force * (f.lam[0].coef.abs() + f.lam[1].coef.abs()).max(1.0)
         }
@@ -477,7 +534,11 @@ impl Tol {
     /// threshold without computing the threshold.
     fn upper(&self, f: &crate::piece::LinForm) -> f64 {
         match (&self.rows, f.disp.coef != 0.0) {
-            (Some(r), true) => (self.widen * r.upper(f.disp.index)).max(self.min_row),
+            (Some(r), true) => {
+                let k = f.disp.index;
+                let floor = r.floor_with(k, self.min_row, self.determined, |j| r.wl_upper(j));
+                (self.widen * r.upper(k)).max(floor)
+            }
             _ => self.of(f),
         }
     }
@@ -871,11 +932,13 @@ impl Path {
         let rows = TolRows {
             problem: self.problem.clone(),
             factor: z * r0,
+            r0,
             base,
             abs_lam: pt.lam.iter().map(|v| v.abs()).collect(),
             lam_max: inf_norm(&pt.lam),
             floor: ROW_FLOOR * z * scale,
-            exact: (0..m)
+            terms: qt,
+            wl: (0..m)
                 .map(|_| std::sync::atomic::AtomicU64::new(f64::NAN.to_bits()))
                 .collect(),
         };
@@ -887,6 +950,7 @@ impl Path {
             rounding: ROUNDING,
             widen: 1.0,
             min_row: 0.0,
+            determined: 0.0,
             cone: false,
         };
         self.tol_cache.put(pt.alpha, &pt.lam, tol.clone());

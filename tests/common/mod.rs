@@ -1118,8 +1118,18 @@ fn assemble_q1(
 /// pressure plus random perturbations as f0, a random top shear/lift and right-edge
 /// traction as f1, friction `friction` at every node.
 pub fn fe_case(seed: u64, nx: usize, ny: usize, friction: f64) -> Case {
+    fe_case_sized(seed, nx, ny, friction, None)
+}
+
+/// [`fe_case`] on the rectangle (0, lx) × (0, ly) (a slender strip where `lx ≫ ly`).
+pub fn fe_strip(seed: u64, nx: usize, ny: usize, friction: f64, lx: f64, ly: f64) -> Case {
+    fe_case_sized(seed, nx, ny, friction, Some((lx, ly)))
+}
+
+fn fe_case_sized(seed: u64, nx: usize, ny: usize, friction: f64, size: Option<(f64, f64)>) -> Case {
     let mut rng = Rng::new(seed.wrapping_add(0xFE));
-    let (lx, ly) = (rng.range(1.0, 3.0), rng.range(0.5, 2.0));
+    let drawn = (rng.range(1.0, 3.0), rng.range(0.5, 2.0));
+    let (lx, ly) = size.unwrap_or(drawn);
     let (hx, hy) = (lx / nx as f64, ly / ny as f64);
     // free dofs: nodes with i ≥ 1
     let dof = |i: usize, j: usize, k: usize| -> Option<usize> {
