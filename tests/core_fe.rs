@@ -229,7 +229,6 @@ fn in_a_corner(seed: u64) -> Case {
 /// all agreeing.)
 #[test]
 fn curved_foundations_and_corners_against_the_reference() {
-    use common::reference::{Condensed, compare_with_fricont};
     let (mut events, mut folds) = (0, 0);
     for seed in 0..24u64 {
         for (kind, case) in [
@@ -237,19 +236,8 @@ fn curved_foundations_and_corners_against_the_reference() {
             ("corner", in_a_corner(seed)),
         ] {
             let d = &case.data;
-            let c = compare_with_fricont(
-                &Condensed::from_data(d),
-                Arc::new(d.problem()),
-                d.f0.as_slice(),
-                d.f1.as_slice(),
-                case.a0,
-                case.a1,
-                1e-9,
-                &mut |_, _| {},
-            );
             let ctx = format!("{kind} seed {seed} (p = {}, F = {})", d.p, d.friction[0]);
-            c.check(1e-9).unwrap_or_else(|e| panic!("{ctx}: {e}"));
-            assert_eq!(c.fricont_end.1, "window", "{ctx}");
+            let c = against_the_reference(&ctx, &case);
             events += c.fricont.len();
             folds += c.folds.0;
         }
@@ -271,28 +259,37 @@ fn curved_foundations_and_corners_against_the_reference() {
 /// each of these four strips, without any error; two on one of them).
 #[test]
 fn slender_strips_against_the_reference() {
-    use common::reference::{Condensed, compare_with_fricont};
     for (seed, nx, ny, ly) in [
         (11u64, 100usize, 2usize, 0.1),
         (3, 100, 3, 0.1),
         (10, 150, 3, 0.2),
         (4, 200, 3, 0.2),
     ] {
-        let case = common::fe_strip(seed, nx, ny, 5.0, 10.0, ly);
-        let d = &case.data;
-        let c = compare_with_fricont(
-            &Condensed::from_data(d),
-            Arc::new(d.problem()),
-            d.f0.as_slice(),
-            d.f1.as_slice(),
-            -2.0,
-            2.0,
-            1e-9,
-            &mut |_, _| {},
-        );
+        let mut case = common::fe_strip(seed, nx, ny, 5.0, 10.0, ly);
+        (case.a0, case.a1) = (-2.0, 2.0);
         let ctx = format!("seed {seed}, {nx} × {ny} elements on 10 × {ly}");
-        c.check(1e-9).unwrap_or_else(|e| panic!("{ctx}: {e}"));
-        assert_eq!(c.fricont_end.1, "window", "{ctx}");
+        let c = against_the_reference(&ctx, &case);
         assert!(c.fricont.len() >= 80, "{ctx}: {} events", c.fricont.len());
     }
+}
+
+/// `case` traced by fricont (default options) and by the independent tracer of
+/// `tests/common/reference.rs` on its window: the same start, the same transitions at the
+/// same α to 1e-9 relative to max(1, |α|), and fricont ending at the window's end.
+fn against_the_reference(ctx: &str, case: &common::Case) -> common::reference::Comparison {
+    use common::reference::{Condensed, compare_with_fricont};
+    let d = &case.data;
+    let c = compare_with_fricont(
+        &Condensed::from_data(d),
+        Arc::new(d.problem()),
+        d.f0.as_slice(),
+        d.f1.as_slice(),
+        case.a0,
+        case.a1,
+        1e-9,
+        &mut |_, _| {},
+    );
+    c.check(1e-9).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+    assert_eq!(c.fricont_end.1, "window", "{ctx}");
+    c
 }
