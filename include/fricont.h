@@ -1310,9 +1310,10 @@ fricont_status fricont_path_set_monitor(struct fricont_path *path,
 
 /**
  * Starts (or restarts) the path at `alpha` with the fixed-α solver (semi-smooth Newton
- * with a line search, then projected block Gauss–Seidel if that stalls), from the contact forces `guess` = (λν, λt) or, if `guess` is
- * NULL, from zero forces. A restart clears the events and pieces traced so far. The load
- * callbacks may be called.
+ * with a line search; where that stalls, projected block Gauss–Seidel and a continuation
+ * in the friction coefficients), from the contact forces `guess` = (λν, λt) or, if
+ * `guess` is NULL, from zero forces. A restart clears the events and pieces traced so
+ * far. The load callbacks may be called.
  *
  * The problem at one α can have several solutions (large friction, a path that folds
  * back over `alpha`); the solver returns one of them, and which one can depend on
