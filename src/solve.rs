@@ -582,9 +582,9 @@ fn newton_active_newton(
     Err((lam, notes))
 }
 
-/// Where Newton and Gauss–Seidel stall: continuation in the friction coefficients, `F_i(t) = t F_i` for t from 0
-/// to 1, each step's solve ([`newton_active_newton`]) started from the last one's
-/// solution. With large friction the damped Newton can stall
+/// Where Newton and Gauss–Seidel stall: continuation in the friction coefficients,
+/// `F_i(t) = t F_i` for t from 0 to 1, each step's solve ([`newton_active_newton`])
+/// started from the last one's solution. With large friction the damped Newton can stall
 /// at a stationary point of its merit function that is no solution (found on random
 /// problems with F up to 5: 3 starts in 6000), while the frictionless problem (a
 /// monotone complementarity problem in the normal forces) is solved from zero forces,

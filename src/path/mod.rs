@@ -468,9 +468,8 @@ impl Tol {
 
     /// Every threshold (and `arc`) times `k`, no displacement row's below the floor of
     /// [`Widen::min_row`] and [`Widen::determined`], and open nodes' `λt` as
-    /// [`Widen::cone`] says: see `join::transit`,
-    /// its retries where the usual thresholds find no continuation or several, or one that
-    /// the data do not determine.
+    /// [`Widen::cone`] says: see `join::transit`, its retries where the usual thresholds
+    /// find no continuation or several, or one that the data do not determine.
     pub(super) fn widened(mut self, w: Widen) -> Self {
         self.force *= w.k;
         self.disp *= w.k;
