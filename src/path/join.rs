@@ -54,12 +54,8 @@ impl Path {
         };
         let mut out = vec![first];
         if !self.problem.extended_precision() {
-            let bound = self
-                .load
-                .relative_determination(pt.alpha, self.problem.delassus())
-                .map_or(1.0, |rho| {
-                    self.problem.w_condition_estimate() * rho / self.opts.zero_tol
-                });
+            // `first.determined` is the condensation's relative error
+            let bound = self.problem.w_condition_estimate() * first.determined / self.opts.zero_tol;
             let mut k = 4.0;
             while k <= bound.min(MAX_WIDENING) {
                 out.push(Widen { k, ..first });

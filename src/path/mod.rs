@@ -373,8 +373,6 @@ pub(super) struct TolRows {
     r0: f64,
     /// `|q_k|ₜ` per row (the magnitude of the terms of `q_k(α)`).
     terms: Vec<f64>,
-    /// `|q_k|ₜ + |g_k|` per row.
-    base: Vec<f64>,
     abs_lam: Vec<f64>,
     lam_max: f64,
     floor: f64,
@@ -398,8 +396,19 @@ impl TolRows {
         v
     }
 
+    /// `|q_k|ₜ + |g_k|` (the gap in the normal rows only).
+    fn base(&self, k: usize) -> f64 {
+        let p = self.terms.len() / 2;
+        self.terms[k]
+            + if k < p {
+                self.problem.gap_equilibrated()[k].abs()
+            } else {
+                0.0
+            }
+    }
+
     fn exact(&self, k: usize) -> f64 {
-        (self.factor * (self.base[k] + self.wl(k))).max(self.floor)
+        (self.factor * (self.base(k) + self.wl(k))).max(self.floor)
     }
 
     /// An upper bound of `(|W||λ|)_k` in O(1): `(|W| 1)_k ‖λ‖∞`.
@@ -409,7 +418,7 @@ impl TolRows {
 
     /// An upper bound of [`Self::exact`] in O(1).
     fn upper(&self, k: usize) -> f64 {
-        (self.factor * (self.base[k] + self.wl_upper(k))).max(self.floor)
+        (self.factor * (self.base(k) + self.wl_upper(k))).max(self.floor)
     }
 
     /// The floor under row k's threshold ([`Widen::min_row`], [`Widen::determined`]):
@@ -923,16 +932,10 @@ impl Path {
         let r0 = self.problem.default_r();
         let m = pt.lam.len();
         let qt = self.term_rows(pt);
-        let gap = self.problem.gap_equilibrated();
-        let p = self.problem.p();
-        let base = (0..m)
-            .map(|k| qt[k] + if k < p { gap[k].abs() } else { 0.0 })
-            .collect();
         let rows = TolRows {
             problem: self.problem.clone(),
             factor: z * r0,
             r0,
-            base,
             abs_lam: pt.lam.iter().map(|v| v.abs()).collect(),
             lam_max: inf_norm(&pt.lam),
             floor: ROW_FLOOR * z * scale,
