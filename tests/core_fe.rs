@@ -277,18 +277,7 @@ fn slender_strips_against_the_reference() {
 /// `tests/common/reference.rs` on its window: the same start, the same transitions at the
 /// same α to 1e-9 relative to max(1, |α|), and fricont ending at the window's end.
 fn against_the_reference(ctx: &str, case: &common::Case) -> common::reference::Comparison {
-    use common::reference::{Condensed, compare_with_fricont};
-    let d = &case.data;
-    let c = compare_with_fricont(
-        &Condensed::from_data(d),
-        Arc::new(d.problem()),
-        d.f0.as_slice(),
-        d.f1.as_slice(),
-        case.a0,
-        case.a1,
-        1e-9,
-        &mut |_, _| {},
-    );
+    let c = common::reference::compare_case(case, Arc::new(case.data.problem()), 1e-9);
     c.check(1e-9).unwrap_or_else(|e| panic!("{ctx}: {e}"));
     assert_eq!(c.fricont_end.1, "window", "{ctx}");
     c

@@ -366,21 +366,12 @@ fn mirror_symmetric_bodies_under_an_oscillating_load() {
 ///   transition at the same α.
 #[test]
 fn mirror_symmetric_finite_element_bodies() {
-    use common::reference::{Condensed, compare_events, compare_with_fricont};
+    use common::reference::{compare_case, compare_events};
     let (mut windows, mut stops, mut pairs) = (0, 0, 0);
     for seed in 0..30u64 {
         let (case, nx, ctx) = mirror_body(seed);
         let data = &case.data;
-        let c = compare_with_fricont(
-            &Condensed::from_data(data),
-            Arc::new(data.problem()),
-            data.f0.as_slice(),
-            data.f1.as_slice(),
-            case.a0,
-            case.a1,
-            1e-8,
-            &mut |_, _| {},
-        );
+        let c = compare_case(&case, Arc::new(data.problem()), 1e-8);
         assert!(
             c.start_diff <= 1e-8,
             "{ctx}: start λ differ by {:e}",
@@ -438,7 +429,7 @@ fn mirror_symmetric_finite_element_bodies() {
 /// tracer (its own condensation in double): the same events to 1e-8; and mirrored.
 #[test]
 fn mirror_symmetric_bodies_in_double_precision() {
-    use common::reference::{Condensed, compare_events, compare_with_fricont};
+    use common::reference::{compare_case, compare_events};
     let cases = [
         (2u64, 100usize, 3usize, 0.3),
         (2, 150, 3, 0.3),
@@ -481,16 +472,7 @@ fn mirror_symmetric_bodies_in_double_precision() {
                 e.alpha
             );
         }
-        let c = compare_with_fricont(
-            &Condensed::from_data(data),
-            problem,
-            data.f0.as_slice(),
-            data.f1.as_slice(),
-            case.a0,
-            case.a1,
-            1e-8,
-            &mut |_, _| {},
-        );
+        let c = compare_case(&case, problem, 1e-8);
         assert!(c.reference.end.is_ok(), "{ctx}: {:?}", c.reference.end);
         let want: Vec<common::reference::Ev> = c
             .reference

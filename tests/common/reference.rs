@@ -1424,6 +1424,26 @@ pub fn compare_on_rounded(
     )
 }
 
+/// [`compare_with_fricont`] on a test case: `problem` (built from `case`'s data) traced
+/// under its affine load on its window, the reference condensing the same data itself.
+pub fn compare_case(
+    case: &super::Case,
+    problem: std::sync::Arc<fricont::Problem>,
+    tol: f64,
+) -> Comparison {
+    let d = &case.data;
+    compare_with_fricont(
+        &Condensed::from_data(d),
+        problem,
+        d.f0.as_slice(),
+        d.f1.as_slice(),
+        case.a0,
+        case.a1,
+        tol,
+        &mut |_, _| {},
+    )
+}
+
 /// Traces `problem` with the affine load `(f0, f1)` on `[a0 → a1]` with fricont (default
 /// options) and with the reference tracer on `cond` (the same data condensed
 /// independently), starting the reference from fricont's start classes after checking
