@@ -256,7 +256,10 @@ fn curved_foundations_and_corners_against_the_reference() {
 /// down near the clamp while sliding was reported as open → stick, where the reference
 /// has open → slip: the retries' floor on the displacement rows was the error of q's
 /// largest row, far above the node's own tangential displacement (one event missing on
-/// each of these four strips, without any error; two on one of them).
+/// each of the first four strips, without any error; two on one of them). On the last
+/// two a node touched down sliding by less than how far the data determine q, and the
+/// retries took stick, where the node slips first and sticks 1e-4 to 1e-2 later in α (the
+/// fifth reported one event fewer, the sixth stopped with the node fitting no class).
 #[test]
 fn slender_strips_against_the_reference() {
     for (seed, nx, ny, ly) in [
@@ -264,6 +267,8 @@ fn slender_strips_against_the_reference() {
         (3, 100, 3, 0.1),
         (10, 150, 3, 0.2),
         (4, 200, 3, 0.2),
+        (3, 150, 2, 0.1),
+        (3, 200, 3, 0.1),
     ] {
         let mut case = common::fe_strip(seed, nx, ny, 5.0, 10.0, ly);
         (case.a0, case.a1) = (-2.0, 2.0);
