@@ -894,7 +894,11 @@ impl Path {
                     }
                     seen.sort_by(order);
                     let j = seen.iter().position(|e| e.0 == smin).expect("kept");
-                    if seen[j].1[k].value < -tol[k] && cut.is_none_or(|c| dir * (smin - c) < 0.0) {
+                    // (below zero from above it: a dip through zero, see `through` below)
+                    let dip = seen[j].1[k].value;
+                    if (dip < -tol[k] || (dip < 0.0 && ga[k].value > 0.0))
+                        && cut.is_none_or(|c| dir * (smin - c) < 0.0)
+                    {
                         cut = Some(smin);
                     }
                     // Kept: the ends, the minimum and its neighbours.
@@ -974,9 +978,29 @@ impl Path {
                 }
             }
             self.graph_step.set(Some(delta.abs()));
+            // A guard crosses where it is below its threshold at b, or where it went
+            // through zero, decreasing, on this step or the one before (and is below zero
+            // at b). Taken as a crossing only once below its threshold, a guard that
+            // reached zero first was left for the transition at another's root, or missed
+            // where it dipped back: under `f0 + φ(α) f1` on a slender strip, a gap closing
+            // at a slope of 6.3e-7 stood at −8.0e-12 (threshold 1.05e-11) where another
+            // node's guard crossed, and its node touched down there, 5.5e-5 in φ late;
+            // another gap dipped to −5.6e-12 (threshold 1.5e-11) about φ's turn, and its
+            // touchdown and lift-off were missing (the affine path, which takes each
+            // guard's own root, has them).
+            let through = |k: usize| {
+                let falling = |row: &GuardRow| dir * row.slope < 0.0;
+                gb[k].value < 0.0
+                    && falling(&ga[k])
+                    && (ga[k].value > 0.0
+                        || behind.as_ref().is_some_and(|(_, rows)| {
+                            rows[k].guard == gb[k].guard && rows[k].value > 0.0 && falling(&rows[k])
+                        }))
+            };
             let crossing: Vec<usize> = (0..gb.len())
                 .filter(|&k| {
-                    tol.below(k, gb[k].value, 1.0) && !(below[k] && dir * gb[k].slope > 0.0)
+                    (tol.below(k, gb[k].value, 1.0) && !(below[k] && dir * gb[k].slope > 0.0))
+                        || through(k)
                 })
                 .collect();
             if crossing.is_empty() {
