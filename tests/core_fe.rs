@@ -278,6 +278,19 @@ fn slender_strips_against_the_reference() {
     }
 }
 
+/// A start where the fixed-α solver stalls (400 × 4 elements on 10 × 0.1, F = 5: at
+/// α = −2 every stage failed, its friction continuation at 0.875 F, and so on 1e-3 around
+/// it) is reached by the path from a nearby α. The start and the whole path must agree with
+/// the independent reference tracer (which checks that the start's piece reproduces its λ).
+/// Before the nearby starts, `Path::start` returned `SolveFailed` here.
+#[test]
+fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
+    let mut case = common::fe_strip(3, 400, 4, 5.0, 10.0, 0.1);
+    (case.a0, case.a1) = (-2.0, 2.0);
+    let c = against_the_reference("seed 3, 400 × 4 elements on 10 × 0.1", &case);
+    assert!(c.fricont.len() >= 100, "{} events", c.fricont.len());
+}
+
 /// `case` traced by fricont (default options) and by the independent tracer of
 /// `tests/common/reference.rs` on its window: the same start, the same transitions at the
 /// same α to 1e-9 relative to max(1, |α|), and fricont ending at the window's end.

@@ -776,7 +776,11 @@ pub unsafe extern "C" fn fricont_path_set_monitor(
 /// with a line search; where that stalls, projected block Gauss–Seidel and a continuation
 /// in the friction coefficients), from the contact forces `guess` = (λν, λt) or, if
 /// `guess` is NULL, from zero forces. A restart clears the events and pieces traced so
-/// far. The load callbacks may be called.
+/// far. The load callbacks may be called. Where every stage of the solver fails at
+/// `alpha`, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the window's length away,
+/// toward `alpha_end` first, inside the window) and traces the path from there back to
+/// `alpha`: the point it reaches is the start (`FRICONT_ERR_SOLVE_FAILED` only where
+/// none leads there; the message says what each reached).
 ///
 /// The problem at one α can have several solutions (large friction, a path that folds
 /// back over `alpha`); the solver returns one of them, and which one can depend on

@@ -573,6 +573,10 @@ impl<T: Clone> PointCache<T> {
             .map(|(_, _, v)| v.clone())
     }
 
+    fn clear(&self) {
+        self.0.borrow_mut().clear();
+    }
+
     /// Keeps `v` for `(alpha, lam)`, dropping the oldest entry beyond [`Self::KEEP`].
     fn put(&self, alpha: f64, lam: &[f64], v: T) {
         let mut cache = self.0.borrow_mut();
@@ -1455,9 +1459,85 @@ impl Path {
     /// start lies on a vertical piece (a continuum at this α), the path follows the way
     /// along it that leads toward `alpha_end` (tried by stepping along each; events met on
     /// the way are the path's own).
+    /// Where the fixed-α solver fails at `alpha`, it solves at a nearby α instead (1e-3,
+    /// 1e-2, 1e-1 of the window's length away, toward `alpha_end` first) and traces the
+    /// path from there back to `alpha`: its point there is the start.
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
-    /// fails, the load fails, no piece leaves the start point toward `alpha_end`.
+    /// fails (also from every nearby α), the load fails, no piece leaves the start point
+    /// toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
+        match self.start_solved(alpha, guess) {
+            Err(e @ Error::SolveFailed { .. }) => self.start_from_nearby(alpha, e),
+            r => r,
+        }
+    }
+
+    /// The fixed-α solver can stall where the problem has a regular solution: on a slender
+    /// strip (400 × 4 elements on 10 × 0.1, F = 5) every stage failed at α = −2 and on
+    /// 1e-3 around it, while at α = −1.996 it converged and the path from there reached
+    /// −2 on the same piece. Then the start is solved at α ± δ (δ = 1e-3, 1e-2, 1e-1 of the
+    /// window's length, toward `alpha_end` first, inside the window) and the path traced
+    /// from there to α (a window of its own; its events are dropped); the point it reaches
+    /// is the start's guess, kept by the solver as it solves the problem. Returns `failed`,
+    /// with what the nearby starts reached, where none leads to α.
+    fn start_from_nearby(&mut self, alpha: f64, failed: Error) -> Result<()> {
+        let opts = self.opts.clone();
+        let (lo, hi) = self.window();
+        let toward = if opts.alpha_end >= alpha { 1.0 } else { -1.0 };
+        let mut tried = Vec::new();
+        let mut reached = None;
+        'nearby: for frac in [1e-3, 1e-2, 1e-1] {
+            for side in [toward, -toward] {
+                let a1 = (alpha + side * frac * (hi - lo)).clamp(lo, hi);
+                if a1 == alpha {
+                    continue;
+                }
+                self.opts.alpha_start = a1;
+                self.opts.alpha_end = alpha;
+                let run = self.start_solved(a1, None).and_then(|_| self.run());
+                let end = self
+                    .pieces()
+                    .last()
+                    .filter(|p| p.alpha_to == alpha)
+                    .map(|p| p.lambda_to.clone());
+                self.opts = opts.clone();
+                match (run, end) {
+                    (Ok(EndReason::Window), Some(lam)) => {
+                        reached = Some(Ok(lam));
+                        break 'nearby;
+                    }
+                    // The host's load failed: its error, not the solver's.
+                    (Err(e @ Error::Load { .. }), _) => {
+                        reached = Some(Err(e));
+                        break 'nearby;
+                    }
+                    (Ok(r), _) => tried.push(format!("from alpha = {a1:e}: ended ({})", r.name())),
+                    (Err(e), _) => tried.push(format!("from alpha = {a1:e}: {e}")),
+                }
+            }
+        }
+        // The thresholds of a general load depend on the window's length; nothing of the
+        // probes stays with the path.
+        self.tol_cache.clear();
+        self.scale_cache.clear();
+        self.trace = None;
+        let Some(lam) = reached else {
+            let Error::SolveFailed { alpha, message } = failed else {
+                return Err(failed);
+            };
+            return Err(Error::SolveFailed {
+                alpha,
+                message: format!(
+                    "{message}; no path from a nearby alpha reached it ({})",
+                    tried.join("; ")
+                ),
+            });
+        };
+        self.start_solved(alpha, Some(&lam?))
+    }
+
+    /// [`Self::start`] with the fixed-α solver at `alpha` only.
+    fn start_solved(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
         let _pool = self.pool_scope();
         self.trace = None;
         // A path's numbers depend on its own history only: no factorisation from an
