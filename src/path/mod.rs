@@ -923,16 +923,26 @@ impl Path {
 
     /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
     /// ([`BoundLoad::term_magnitude_rows`]); for a general load, whose terms are not
-    /// known, `|q_k|` plus the change of `q_k` over the window
-    /// ([`Self::sample_window_change`]; before it is sampled, and for basis weights not
-    /// at hand, `|α_end − α_start| |q'_k|`).
+    /// known, `|q_k|` plus the change of `q_k` over the window, at most
+    /// `|α_end − α_start| |q'_k(α)|` ([`Self::sample_window_change`]; before it is
+    /// sampled, and for basis weights not at hand, that bound). A general load is
+    /// evaluated relative to its piece's entry, so its rounding follows the change since
+    /// there, which the bound keeps small where q' vanishes: at the bottom of a dip of
+    /// a node's force through zero by 2e-12, the sampled change alone (the whole swing
+    /// of the sine) took the reopened gap at zero over the dip, and the touchdown came
+    /// 2.8e-7 in α late.
     fn term_rows(&self, pt: &Point) -> Vec<f64> {
-        self.load
-            .term_magnitude_rows(pt.alpha)
-            .unwrap_or_else(|| match &self.window_change {
-                Some(change) => pt.q.iter().zip(change).map(|(q, c)| q.abs() + c).collect(),
-                None => self.terms_from_slope(pt),
-            })
+        self.load.term_magnitude_rows(pt.alpha).unwrap_or_else(|| {
+            let slope = self.terms_from_slope(pt);
+            match &self.window_change {
+                Some(change) => slope
+                    .iter()
+                    .zip(pt.q.iter().zip(change))
+                    .map(|(s, (q, c))| s.min(q.abs() + c))
+                    .collect(),
+                None => slope,
+            }
+        })
     }
 
     /// `|q_k| + |α_end − α_start| |q'_k|` per row.
@@ -947,12 +957,12 @@ impl Path {
     /// A general load's change of each row of q over the window, once per path: the range
     /// of `q_k` at [`WINDOW_SAMPLES`] + 1 equispaced α (the window's ends included) plus
     /// the sample spacing times the largest `|q'_k|` there (what the range between two
-    /// samples can add). It stood for the change as `|α_end − α_start| |q'_k(α)|`, which
-    /// is many times the change for a load that oscillates in the window (about 10 times
-    /// for `f0 − 2 cos(5α) f1` over two periods) and vanishes where q' does: on a slender
-    /// strip a gap closing at 4.6e-12 was taken at zero with another node's transition,
-    /// its touchdown 4.4e-4 early in the load's phase. Costs the load's evaluations (a
-    /// solve with A each), a few against those of the march.
+    /// samples can add). Alone, `|α_end − α_start| |q'_k(α)|` stood for the change: many
+    /// times it for a load that oscillates in the window (about 10 times for
+    /// `f0 − 2 cos(5α) f1` over two periods), and on a slender strip a gap closing at
+    /// 4.6e-12 was taken at zero with another node's transition, its touchdown 4.4e-4
+    /// early in the load's phase ([`Self::term_rows`] takes the smaller of the two). Costs
+    /// the load's evaluations (a solve with A each), a few against those of the march.
     fn sample_window_change(&mut self) {
         if !self.load.is_general() || self.window_change.is_some() {
             return;
