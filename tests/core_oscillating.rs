@@ -428,27 +428,9 @@ fn a_narrow_bump_needs_max_alpha_step_and_is_found_with_it() {
 /// its touchdown and lift-off.
 #[test]
 fn slender_strips_under_an_oscillating_basis_load_walk_the_affine_path() {
-    for (seed, nx, ny, ly) in [(4u64, 150usize, 2usize, 0.2), (8, 200, 3, 0.1)] {
-        walk_the_affine_path(seed, nx, ny, ly, false);
-    }
-}
-
-/// As `slender_strips_under_an_oscillating_basis_load_walk_the_affine_path`, with the
-/// load given as a general one (f and f' evaluated by a closure). Its thresholds include
-/// the change of q over the window, which was estimated as the window's length times
-/// |q'(α)|, about 10 times the change for this load: a gap closing at 4.6e-12 was taken at
-/// zero with another node's transition, its touchdown 4.4e-4 early in φ.
-#[test]
-fn a_slender_strip_under_an_oscillating_general_load_walks_the_affine_path() {
-    walk_the_affine_path(5, 200, 2, 0.1, true);
-}
-
-/// The walk of the two tests above for `fe_strip(seed, nx, ny, 5, 10, ly)`, its load
-/// given as a basis or (`general`) a general load.
-fn walk_the_affine_path(seed: u64, nx: usize, ny: usize, ly: f64, general: bool) {
     let (amp, omega) = (2.0f64, 5.0f64);
-    {
-        let ctx = format!("seed {seed}, {nx} × {ny} elements on 10 × {ly}, general {general}");
+    for (seed, nx, ny, ly) in [(4u64, 150usize, 2usize, 0.2), (8, 200, 3, 0.1)] {
+        let ctx = format!("seed {seed}, {nx} × {ny} elements on 10 × {ly}");
         let mut case = common::fe_strip(seed, nx, ny, 5.0, 10.0, ly);
         (case.a0, case.a1) = (-amp, amp);
         let problem = Arc::new(case.data.problem());
@@ -487,29 +469,11 @@ fn walk_the_affine_path(seed: u64, nx: usize, ny: usize, ly: f64, general: bool)
             Ok::<(), LoadFailure>(())
         };
         let d = &case.data;
-        let (f0, f1) = (d.f0.as_slice().to_vec(), d.f1.as_slice().to_vec());
-        let load = if general {
-            let (g0, g1) = (f0.clone(), f1.clone());
-            Load::general(
-                f0.len(),
-                Box::new(move |a: f64, out: &mut [f64]| {
-                    let s = -amp * (omega * a).cos();
-                    for (o, (x, y)) in out.iter_mut().zip(g0.iter().zip(&g1)) {
-                        *o = x + s * y;
-                    }
-                    Ok(())
-                }),
-                Some(Box::new(move |a: f64, out: &mut [f64]| {
-                    let s = amp * omega * (omega * a).sin();
-                    for (o, y) in out.iter_mut().zip(&f1) {
-                        *o = s * y;
-                    }
-                    Ok(())
-                })),
-            )
-        } else {
-            Load::basis(vec![f0, f1], Box::new(weights)).unwrap()
-        };
+        let load = Load::basis(
+            vec![d.f0.as_slice().to_vec(), d.f1.as_slice().to_vec()],
+            Box::new(weights),
+        )
+        .unwrap();
         let a1 = 4.0 * PI / omega;
         let mut path = Path::new(problem, load, PathOptions::window(0.0, a1)).unwrap();
         path.start(0.0, None).unwrap();

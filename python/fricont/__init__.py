@@ -451,9 +451,7 @@ class Problem:
         Affine load: ``f(alpha) = f0 + alpha * f1`` (length-n arrays, force units).
         General load: ``load(alpha)`` returns f (length n), ``dload(alpha)`` its derivative
         (central differences when None); ``n`` defaults to the problem's n. Each evaluation
-        costs a solve with the Cholesky factor of A. The start evaluates it at 33
-        equispaced alphas across the window: the load's change there sets the zero
-        thresholds (its terms are not known otherwise).
+        costs a solve with the Cholesky factor of A.
         Basis load: ``f(alpha) = sum_j phi_j(alpha) basis[j]``, ``basis`` k vectors of
         length n, ``weights(alpha)`` returns ``(phi, dphi)``, the k weights and their
         derivatives. Each vector is condensed once, so an evaluation costs O(k p) instead

@@ -345,13 +345,12 @@ impl Problem {
     }
 }
 
-/// A Python load callable (`what`) raised `e`: `e` is kept in `slot` (the latest one, for
-/// the Python layer to re-raise: the start's samples of a general load go on past a
-/// failure, the trace stops at one) and the library gets a failure that names it.
+/// A Python load callable (`what`) raised `e`: `e` is kept in `slot` (the first one, for
+/// the Python layer to re-raise) and the library gets a failure that names it.
 fn keep_error(slot: &Mutex<Option<PyErr>>, what: &str, e: PyErr) -> LoadFailure {
     let message = format!("{what} raised {e}");
     if let Ok(mut s) = slot.lock() {
-        *s = Some(e);
+        s.get_or_insert(e);
     }
     LoadFailure { code: 1, message }
 }
@@ -607,15 +606,13 @@ impl Path {
             tm.trace_s += t.elapsed().as_secs_f64();
         }
         // A Python load's own exception is what stopped the path, not the library's
-        // LoadError that wraps it (only for a LoadError: the start samples a general load
-        // across the window and goes on where one of those evaluations fails).
+        // LoadError that wraps it.
         let load_error = self
             .load_error
             .as_ref()
             .and_then(|s| s.lock().ok().and_then(|mut g| g.take()));
         let error = match outcome {
-            Err(e) if e.is_instance_of::<LoadError>(py) => Some(load_error.unwrap_or(e)),
-            Err(e) => Some(e),
+            Err(e) => Some(load_error.unwrap_or(e)),
             Ok(()) => monitor_error,
         };
         *self.error.lock().map_err(poisoned)? = error;

@@ -536,9 +536,6 @@ pub unsafe extern "C" fn fricont_path_new_basis(
 /// derivative callback. Each evaluation costs one solve with the Cholesky factor of A.
 /// Without a derivative, f'(α) is approximated by central differences (used only for step
 /// control and orientation: transition points are located on the guards themselves).
-/// The first `fricont_path_start` evaluates the load (and its derivative) at 33 equispaced
-/// α across the window: the load's change there sets the zero thresholds of the
-/// displacement guards (its terms are not known otherwise).
 ///
 /// * `problem`: not NULL (see `fricont_path_new_affine`).
 /// * `n`: the load's length; must equal the problem's n.

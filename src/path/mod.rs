@@ -256,9 +256,6 @@ pub struct Path {
     /// The last few force scales with their (α, λ): a transition reads those of its point
     /// and of the point it came from several times, each an O(m) scan.
     scale_cache: PointCache<f64>,
-    /// A general load's change of each row of q over the window (see
-    /// [`Self::sample_window_change`]); None for the other loads and before the first start.
-    window_change: Option<Vec<f64>>,
     /// The last step (α units) that the march of a nonlinear load trusted: the next
     /// piece's march starts from twice that, not from the window's scale.
     graph_step: Cell<Option<f64>>,
@@ -361,10 +358,6 @@ impl Widen {
         cone: false,
     };
 }
-
-/// Intervals of α over the window at whose ends a general load is sampled
-/// ([`Path::sample_window_change`]).
-const WINDOW_SAMPLES: usize = 32;
 
 /// The rounding of a guard's value at an exactly computed point, as a fraction of
 /// [`Tol::of`].
@@ -839,7 +832,6 @@ impl Path {
             trace: None,
             updater: RefCell::new(None),
             refactorisations: Cell::new(0),
-            window_change: None,
             gaps_cache: PointCache::new(),
             tol_cache: PointCache::new(),
             scale_cache: PointCache::new(),
@@ -892,23 +884,13 @@ impl Path {
     /// passes through zero the rounding of q is still proportional to T. A gap enters only
     /// where it is negative enough to press (an initial overlap): a node far from the
     /// foundation does not set the scale of the others. For affine and basis loads it
-    /// depends on the point alone, never on the window. For a general load T is
-    /// `max_k |q_k| + |α_end − α_start| |q'_k|`, the rows' magnitude before the window
-    /// was sampled: the forces of a march along a general load carry more than the rows'
-    /// rounding (with the sampled change in the force scale too, a stick node's cone
-    /// guard on a slender strip came out at −1.7 times its threshold at its own
-    /// transition point, and the path stopped there).
+    /// depends on the point alone, never on the window.
     fn force_scale(&self, pt: &Point) -> f64 {
         if let Some(s) = self.scale_cache.get(pt.alpha, &pt.lam) {
             return s;
         }
         let r0 = self.problem.default_r();
-        let terms = self
-            .load
-            .term_magnitude_rows(pt.alpha)
-            .unwrap_or_else(|| self.terms_from_slope(pt))
-            .iter()
-            .fold(0.0f64, |a, &b| a.max(b));
+        let terms = self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b));
         let overlap =
             pt.q.iter()
                 .zip(self.problem.gap_equilibrated())
@@ -923,86 +905,15 @@ impl Path {
 
     /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
     /// ([`BoundLoad::term_magnitude_rows`]); for a general load, whose terms are not
-    /// known, `|q_k|` plus the change of `q_k` over the window, at most
-    /// `|α_end − α_start| |q'_k(α)|` ([`Self::sample_window_change`]; before it is
-    /// sampled, and for basis weights not at hand, that bound). A general load is
-    /// evaluated relative to its piece's entry, so its rounding follows the change since
-    /// there, which the bound keeps small where q' vanishes: at the bottom of a dip of
-    /// a node's force through zero by 2e-12, the sampled change alone (the whole swing
-    /// of the sine) took the reopened gap at zero over the dip, and the touchdown came
-    /// 2.8e-7 in α late.
+    /// known, `|q_k| + |α_end − α_start| |q'_k|` (the change of q over the window).
     fn term_rows(&self, pt: &Point) -> Vec<f64> {
         self.load.term_magnitude_rows(pt.alpha).unwrap_or_else(|| {
-            let slope = self.terms_from_slope(pt);
-            match &self.window_change {
-                Some(change) => slope
-                    .iter()
-                    .zip(pt.q.iter().zip(change))
-                    .map(|(s, (q, c))| s.min(q.abs() + c))
-                    .collect(),
-                None => slope,
-            }
+            let span = self.alpha_scale();
+            pt.q.iter()
+                .zip(&pt.dq)
+                .map(|(q, dq)| q.abs() + span * dq.abs())
+                .collect()
         })
-    }
-
-    /// `|q_k| + |α_end − α_start| |q'_k|` per row.
-    fn terms_from_slope(&self, pt: &Point) -> Vec<f64> {
-        let span = self.alpha_scale();
-        pt.q.iter()
-            .zip(&pt.dq)
-            .map(|(q, dq)| q.abs() + span * dq.abs())
-            .collect()
-    }
-
-    /// A general load's change of each row of q over the window, once per path: the range
-    /// of `q_k` at [`WINDOW_SAMPLES`] + 1 equispaced α (the window's ends included) plus
-    /// the sample spacing times the largest `|q'_k|` there (what the range between two
-    /// samples can add). Alone, `|α_end − α_start| |q'_k(α)|` stood for the change: many
-    /// times it for a load that oscillates in the window (about 10 times for
-    /// `f0 − 2 cos(5α) f1` over two periods), and on a slender strip a gap closing at
-    /// 4.6e-12 was taken at zero with another node's transition, its touchdown 4.4e-4
-    /// early in the load's phase ([`Self::term_rows`] takes the smaller of the two). Costs
-    /// the load's evaluations (a solve with A each), a few against those of the march.
-    fn sample_window_change(&mut self) {
-        if !self.load.is_general() || self.window_change.is_some() {
-            return;
-        }
-        let (lo, hi) = self.window();
-        let h = (hi - lo) / WINDOW_SAMPLES as f64;
-        let mut range: Option<(Vec<f64>, Vec<f64>, Vec<f64>)> = None;
-        for j in 0..=WINDOW_SAMPLES {
-            let alpha = if j == WINDOW_SAMPLES {
-                hi
-            } else {
-                lo + j as f64 * h
-            };
-            // Where an evaluation fails (a load near the largest double overflows in part
-            // of the window, a host's load defined on part of it), the estimate from q' at
-            // the point stays: the trace reports the failure only where it goes.
-            let Ok((q, dq)) = self.load.q(alpha, self.problem.delassus()) else {
-                return;
-            };
-            if !q.iter().chain(&dq).all(|v| v.is_finite()) {
-                return;
-            }
-            match &mut range {
-                None => range = Some((q.clone(), q, dq.iter().map(|v| v.abs()).collect())),
-                Some((min, max, slope)) => {
-                    for k in 0..q.len() {
-                        min[k] = min[k].min(q[k]);
-                        max[k] = max[k].max(q[k]);
-                        slope[k] = slope[k].max(dq[k].abs());
-                    }
-                }
-            }
-        }
-        self.window_change = range
-            .map(|(min, max, slope)| -> Vec<f64> {
-                (0..min.len())
-                    .map(|k| (max[k] - min[k]) + h * slope[k])
-                    .collect()
-            })
-            .filter(|c| c.iter().all(|v| v.is_finite()));
     }
 
     /// The "at zero" thresholds at a point. A row `d_k` of the displacement gaps is at
@@ -1639,7 +1550,6 @@ impl Path {
                 "start alpha = {alpha} is outside the window [{lo}, {hi}]"
             )));
         }
-        self.sample_window_change();
         let m = 2 * self.problem.p();
         if let Some(g) = guess {
             if g.len() != m {
