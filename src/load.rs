@@ -439,10 +439,6 @@ impl BoundLoad {
     }
 
     /// True when `f` (hence `q`) is affine in α.
-    pub(crate) fn is_general(&self) -> bool {
-        matches!(self.load, Load::General { .. })
-    }
-
     pub(crate) fn is_affine(&self) -> bool {
         matches!(self.load, Load::Affine { .. })
     }

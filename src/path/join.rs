@@ -559,14 +559,6 @@ impl Path {
         // (its λt is rounding there), where slip in either direction continued the path: a
         // bifurcation, and the path stopped, where it lifts off.
         if cands.len() != 1 {
-            // A general load's determination is its own evaluation's error at the point:
-            // evaluated there again where the march evaluated it last elsewhere (without
-            // it only the cone was retried, and on a slender strip a node sticking with its
-            // tangential displacement at 2 times its threshold stopped the path).
-            let del = self.problem.delassus();
-            if self.load.is_general() && self.load.determination(pt.alpha, del).is_none() {
-                self.load.q(pt.alpha, del)?;
-            }
             let mut first = None;
             for widen in self.widening(&pt) {
                 let wider = match self.continuations_either(
