@@ -1467,7 +1467,7 @@ impl Path {
     /// toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
         match self.start_solved(alpha, guess) {
-            Err(e @ Error::SolveFailed { .. }) => self.start_from_nearby(alpha, e),
+            Err(Error::SolveFailed { message, .. }) => self.start_from_nearby(alpha, message),
             r => r,
         }
     }
@@ -1478,9 +1478,10 @@ impl Path {
     /// −2 on the same piece. Then the start is solved at α ± δ (δ = 1e-3, 1e-2, 1e-1 of the
     /// window's length, toward `alpha_end` first, inside the window) and the path traced
     /// from there to α (a window of its own; its events are dropped); the point it reaches
-    /// is the start's guess, kept by the solver as it solves the problem. Returns `failed`,
-    /// with what the nearby starts reached, where none leads to α.
-    fn start_from_nearby(&mut self, alpha: f64, failed: Error) -> Result<()> {
+    /// is the start's guess, kept by the solver as it solves the problem. Where none leads
+    /// to α: `SolveFailed` with the solver's message `failed` at α and what the nearby
+    /// starts reached.
+    fn start_from_nearby(&mut self, alpha: f64, failed: String) -> Result<()> {
         let opts = self.opts.clone();
         let (lo, hi) = self.window();
         let toward = if opts.alpha_end >= alpha { 1.0 } else { -1.0 };
@@ -1521,19 +1522,16 @@ impl Path {
         self.tol_cache.clear();
         self.scale_cache.clear();
         self.trace = None;
-        let Some(lam) = reached else {
-            let Error::SolveFailed { alpha, message } = failed else {
-                return Err(failed);
-            };
-            return Err(Error::SolveFailed {
+        match reached {
+            Some(lam) => self.start_solved(alpha, Some(&lam?)),
+            None => Err(Error::SolveFailed {
                 alpha,
                 message: format!(
-                    "{message}; no path from a nearby alpha reached it ({})",
+                    "{failed}; no path from a nearby alpha reached it ({})",
                     tried.join("; ")
                 ),
-            });
-        };
-        self.start_solved(alpha, Some(&lam?))
+            }),
+        }
     }
 
     /// [`Self::start`] with the fixed-α solver at `alpha` only.
