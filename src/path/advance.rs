@@ -1069,7 +1069,40 @@ impl Path {
                     .as_ref()
                     .map(|(a, rows)| (*a, rows[k].guard, rows[k].value, rows[k].slope))
                     .filter(|&(_, guard, value, _)| guard == g && value > 0.0 && fa <= 0.0);
-                let root = if let Some((a_prev, _, value, slope)) = earlier {
+                // A guard that rose on the step before and turned down to at or below zero
+                // by α_a, all of it within its threshold (a node that touched down again
+                // within that step: a contact force dipping through zero by less than its
+                // threshold opens its node for a stretch of α shorter than a step): its
+                // root is the one after its maximum on that step (Brent on its slope),
+                // where the maximum is above zero. Taken at α_a, the touchdown was 3.8e-8
+                // in α late under a basis load whose force dipped by 2e-12.
+                let turned = behind
+                    .as_ref()
+                    .filter(|(_, rows)| {
+                        earlier.is_none()
+                            && fa <= 0.0
+                            && dir * ga[k].slope < 0.0
+                            && rows[k].guard == g
+                            && dir * rows[k].slope > 0.0
+                    })
+                    .map(|(a, rows)| (*a, rows[k].slope));
+                let peak = match turned {
+                    Some((a_prev, s_prev)) => {
+                        let top =
+                            brent_fallible(a_prev, a0, dir * s_prev, dir * ga[k].slope, |x| {
+                                Ok(dir * eval(self, x, false)?.1[k].slope)
+                            })?;
+                        let row = eval(self, top, false)?.1[k].clone();
+                        (row.value > 0.0).then_some((top, row.value, row.slope))
+                    }
+                    None => None,
+                };
+                let root = if let Some(top) = peak {
+                    newton_bracketed(top, (a0, fa, ga[k].slope), fine * tol[k], |x| {
+                        let rows = eval(self, x, false)?.1;
+                        Ok((rows[k].value, rows[k].slope))
+                    })?
+                } else if let Some((a_prev, _, value, slope)) = earlier {
                     newton_bracketed(
                         (a_prev, value, slope),
                         (a0, fa, ga[k].slope),
