@@ -285,58 +285,44 @@ impl Path {
     /// slope `slope` per unit α) of the piece `cur` under a basis load corrected on the
     /// point refined in double-double. A point rounded to double carries the rounding of
     /// its terms in each d (ε |W||λ|), and more where it was accepted at a residual above
-    /// rounding level (up to a solve's check, 1e-12; 1.4e-13 on a nearly singular piece
-    /// near a fold). Where the guard crosses at a shallow angle against its terms, that
-    /// moves the root by about ε |terms| / slope, or that residual's share of the terms
-    /// over the slope (4e-9 in φ where a node re-closed at a slope of 5e-8 of its terms;
-    /// 1.9e-9 where a node stuck again near a fold), while the refined d is accurate to
-    /// the data. So where that estimate (from the point's measured residual) exceeds 1e-12
-    /// of the window, `pt` is refined, and the root moved by one Newton step on the
-    /// refined guard, the point with it along the piece's tangent (`bs` at α: a step of
-    /// that error's size, whose own error is its square). `per_tol`: the roundings of a
-    /// guard's terms that count, as a fraction of its zero threshold (64 ε / `zero_tol`,
-    /// as for the march's roots). None when the problem is carried in double, the root is
-    /// well determined in double, or the refinement fails or lands beyond that error.
+    /// rounding level (up to a solve's check, 1e-12), which the piece's conditioning
+    /// amplifies in λ and again in d. Where the guard crosses at a shallow angle against
+    /// its terms, that moves the root by that error over the slope, while the refined d is
+    /// accurate to the data. So `pt` is refined, and the root moved by one Newton step on
+    /// the refined guard, the point with it along the piece's tangent (`bs` at α: a step
+    /// of that error's size, whose own error is its square). The error is measured, not
+    /// estimated: an estimate from the point's residual and the guard's terms (without
+    /// the conditioning) judged a root well determined in double that was 4.2e-9 in α
+    /// (2.8e-8 in φ) off on a slender strip (κ(W) = 1.5e8, F = 5) under a sine load. Steps
+    /// of any size are taken: where a node opens and closes again at one point, steps of
+    /// 1.6e-14 in α put its two events together, as they are on the affine path.
+    /// `within`: the stretch of α the root was found on; a step beyond it means a
+    /// refinement that did not land near this root. None when the problem is carried in
+    /// double, the refinement fails, the step is zero or leaves `within`.
     fn polish_root(
         &mut self,
         cur: &CurrentPiece,
         bs: &BasisSolutions,
-        (k, g, slope): (usize, Guard, f64),
-        per_tol: f64,
+        (k, slope): (usize, f64),
+        within: (f64, f64),
         pt: &Point,
     ) -> Result<Option<Point>> {
         if !self.problem.extended_precision() {
             return Ok(None);
         }
-        let per_rounding = per_tol * self.tol_at(pt).of(&self.consts().guard_form(g));
-        let bound = 1e-12 * self.alpha_scale() * slope.abs();
-        let above = |x: f64| x.partial_cmp(&bound) == Some(std::cmp::Ordering::Greater);
-        // `pt` may have been accepted at a residual up to a solve's check (1e-12), above
-        // rounding level: its guards then carry that much more of their terms. Measured
-        // (one product with W) only where a residual that large could matter.
-        if !above(per_rounding * (1e-12 / f64::EPSILON)) {
-            return Ok(None);
-        }
-        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
-        let rel = self.point_residual(&cur.classes, &qg, &pt.lam).0;
-        let error = per_rounding * (rel / f64::EPSILON).max(1.0);
-        if !above(error) {
-            return Ok(None);
-        }
         let Some((lam, d)) = self.polish_point(&cur.classes, &cur.lu, pt.alpha, &pt.lam) else {
             return Ok(None);
         };
-        // A step within the window, of the size of the error it corrects (more means a
-        // refinement that did not land near this root: `pt` is kept).
         let v = self.guard_rows(&cur.classes, &lam, &d, None)[k].value;
-        let (lo, hi) = self.window();
-        let step = (pt.alpha - v / slope).clamp(lo, hi) - pt.alpha;
-        if v.abs() > error || !step.is_finite() {
+        let step = -v / slope;
+        let (lo, hi) = within;
+        if !(step != 0.0 && (lo..=hi).contains(&(pt.alpha + step))) {
             return Ok(None);
         }
         let Some((w, dw)) = self.load.weights_at(pt.alpha) else {
             return Ok(None);
         };
+        let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
         Ok(Some(self.step_along(
             pt.alpha,
@@ -1267,7 +1253,7 @@ impl Path {
                         pt = self.step_along(pt.alpha, (&pt.lam, &d), (&t, &rate), step)?;
                     }
                 }
-                if let Some(p) = self.polish_root(cur, bs, (k, g, slope), roundings, &pt)? {
+                if let Some(p) = self.polish_root(cur, bs, (k, slope), (lo_a, hi_a), &pt)? {
                     pt = p;
                 }
             }
