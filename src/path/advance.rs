@@ -1083,33 +1083,24 @@ impl Path {
                     }
                     None => None,
                 };
-                let root = if let Some(top) = peak {
-                    newton_bracketed(top, (a0, fa, ga[k].slope), fine * tol[k], |x| {
+                // The root's bracket: after the maximum, on the step before, or on this
+                // step (none for a guard already at or below zero at α_a: the root is α_a).
+                let sa = (a0, fa, ga[k].slope);
+                let bracket = if let Some(top) = peak {
+                    Some((top, sa))
+                } else if let Some((a_prev, _, value, slope)) = earlier {
+                    Some(((a_prev, value, slope), sa))
+                } else if fa <= 0.0 {
+                    None
+                } else {
+                    Some((sa, (b0, fb, gb[k].slope)))
+                };
+                let root = match bracket {
+                    Some((from, to)) => newton_bracketed(from, to, fine * tol[k], |x| {
                         let rows = eval(self, x, false)?.1;
                         Ok((rows[k].value, rows[k].slope))
-                    })?
-                } else if let Some((a_prev, _, value, slope)) = earlier {
-                    newton_bracketed(
-                        (a_prev, value, slope),
-                        (a0, fa, ga[k].slope),
-                        fine * tol[k],
-                        |x| {
-                            let rows = eval(self, x, false)?.1;
-                            Ok((rows[k].value, rows[k].slope))
-                        },
-                    )?
-                } else if fa <= 0.0 {
-                    a0
-                } else {
-                    newton_bracketed(
-                        (a0, fa, ga[k].slope),
-                        (b0, fb, gb[k].slope),
-                        fine * tol[k],
-                        |x| {
-                            let rows = eval(self, x, false)?.1;
-                            Ok((rows[k].value, rows[k].slope))
-                        },
-                    )?
+                    })?,
+                    None => a0,
                 };
                 if first.is_none_or(|f| dir * (root - f.0) < 0.0) {
                     first = Some((root, g));
