@@ -540,6 +540,81 @@ fn slender_strips_under_an_oscillating_basis_load_walk_the_affine_path() {
     }
 }
 
+/// A general load near the point where the last contact force vanishes: a slender strip
+/// (150 × 3 elements on 10 × 0.1, F = 5, κ(W) ~ 1e8, carried in extended precision) under
+/// `f0 + α f1` given as a general load, every event against the independent reference's
+/// affine trace (its own condensation and pieces in double-double). The path lifts the
+/// body off node by node; on its last piece only node 1 is closed (slipping), so that
+/// piece's normal force is `−(q_ν1(α) − g_1) / D` whatever D, and the lift-off is the
+/// root of `q_ν1(α) = g_1`: `(g_1 − q0_ν1) / q1_ν1` by hand from the reference's
+/// condensed load. There the march's points, refined in double-double, were measured
+/// against max|λ| → 0: the refinement failed, the double-precision points (off by
+/// κ(A) ε of the load) stood, and the lift-off came 1.1e-8 in α early.
+#[test]
+fn a_general_load_locates_the_last_lift_off_from_the_data() {
+    let mut case = common::fe_strip(3, 150, 3, 5.0, 10.0, 0.1);
+    (case.a0, case.a1) = (-2.0, 2.0);
+    let problem = Arc::new(case.data.problem());
+    assert!(problem.extended_precision());
+    let c = common::reference::compare_case(&case, problem.clone(), 1e-12);
+    c.check(1e-12).unwrap_or_else(|e| panic!("affine: {e}"));
+    let want = &c.reference.events;
+    let last = want.last().expect("events");
+    assert_eq!(
+        (last.node, last.from, last.to),
+        (0, Class::SlipPlus, Class::Open)
+    );
+    let pieces = &c.reference.pieces;
+    let before = &pieces[pieces.len() - 2].0;
+    assert!(before[0] == Class::SlipPlus && before[1..].iter().all(|&k| k == Class::Open));
+    let cond = common::reference::Condensed::from_data(&case.data);
+    let root = (cond.gap[0] - cond.q0[0] - cond.q0_lo[0]) / (cond.q1[0] + cond.q1_lo[0]);
+    assert!(
+        (last.alpha - root).abs() <= 1e-14,
+        "{} by hand, {}",
+        root,
+        last.alpha
+    );
+
+    let (f0, f1) = (
+        case.data.f0.as_slice().to_vec(),
+        case.data.f1.as_slice().to_vec(),
+    );
+    let n = f0.len();
+    let f = Box::new(move |a: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+        for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+            *o = x + a * y;
+        }
+        Ok(())
+    });
+    let mut path = Path::new(
+        problem,
+        Load::general(n, f, None),
+        PathOptions::window(-2.0, 2.0),
+    )
+    .unwrap();
+    path.start(-2.0, None).unwrap();
+    assert_eq!(path.run().unwrap(), EndReason::Window);
+    let got = path.events();
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.iter().zip(want) {
+        assert!(
+            (g.node, g.from, g.to) == (w.node, w.from, w.to)
+                && (g.alpha - w.alpha).abs() <= 1e-12 * w.alpha.abs().max(1.0),
+            "event {}: α {} node {} {:?} → {:?}, the reference's α {} node {} {:?} → {:?}",
+            g.index,
+            g.alpha,
+            g.node,
+            g.from,
+            g.to,
+            w.alpha,
+            w.node,
+            w.from,
+            w.to
+        );
+    }
+}
+
 /// The node's contact force dips through zero by less than its zero threshold (about
 /// 1e-11 of the load's scale): c0 = 1 − δ with δ from 2e-12 to 1e-11 opens it for a
 /// stretch of α of width 2 √(2δ) / ω (3e-7 at most) about each minimum of the sine. The

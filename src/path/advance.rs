@@ -562,7 +562,7 @@ impl Path {
                     .as_ref()
                     .and_then(|r| self.polish_exit(cur, r, &decreasing));
                 let (lam, alpha, g) = match polished {
-                    Some((l2, a2, g2)) if super::polish::near(&l2, &lam) => {
+                    Some((l2, a2, g2)) if super::polish::near(&l2, &lam, self.force_scale(&pt)) => {
                         on_line = None;
                         (l2, a2, g2)
                     }

@@ -174,12 +174,30 @@ impl Refiner<'_> {
         }
     }
 
+    /// The force scale of the solutions of `W x + c = d` on the piece: `r0 ‖c‖∞`, the
+    /// size the rounding of a double-precision solve is relative to (with max|x|, see
+    /// [`Self::refine_all`]).
+    fn floor(&self, c: &DdVec) -> f64 {
+        self.c.r0 * inf_norm(&c.hi)
+    }
+
     /// Refines each `(x, c)` pair from its double-precision guess to `(x, d = W x + c)`:
     /// residuals `H(x, d)` of the piece equations in double-double and corrections by the
     /// piece's solves, all pairs in lockstep (one pass over the factor and one over W per
     /// round for all of them); d is kept up to date by `W δ` in double (δ is small: its
     /// rounding is ~ε of δ, far below the target). None when one does not converge.
+    ///
+    /// The corrections are measured against max|x| or, where that is smaller, the force
+    /// scale of the data ([`Self::floor`]): a double-precision solve is off by cond · ε of
+    /// that scale, not of x. Near a point where every contact force vanishes (the last
+    /// node of a body lifting off), x goes to zero while its double-precision guess keeps
+    /// that error: measured against max|x|, the first correction (5.7e-8 against a guess
+    /// of 5.7e-8, under a general load on a slender strip, F = 5) failed the refinement,
+    /// the march kept the double-precision points, and the lift-off came 1.1e-8 in α
+    /// early. Only the first round's test ([`FIRST_ROUND`]), whose correction stands for
+    /// what is left after it, stays relative to max|x| (a tiny x then takes more rounds).
     fn refine_all(&self, pairs: Vec<(DdVec, DdVec)>) -> Option<Vec<(DdVec, DdVec)>> {
+        let floors: Vec<f64> = pairs.iter().map(|(_, c)| self.floor(c)).collect();
         let refs: Vec<(&DdVec, &DdVec)> = pairs.iter().map(|(x, c)| (x, c)).collect();
         let ds = gaps_dd(self.w, self.w_lo, &refs);
         let mut xs: Vec<(DdVec, DdVec)> = pairs
@@ -213,11 +231,12 @@ impl Refiner<'_> {
             for ((&j, dx), wdx) in active.iter().zip(&dxs).zip(wdx) {
                 let (x, d) = &mut xs[j];
                 let size = inf_norm(&x.hi);
+                let scale = size.max(floors[j]);
                 let step = inf_norm(dx);
                 // The guess is a double-precision solution: a correction beyond ROUGH of
                 // it means a piece matrix too ill-conditioned for refinement in double
                 // (its solves amplify rounding to that size), not a better point.
-                if !step.is_finite() || step > ROUGH * size {
+                if !step.is_finite() || step > ROUGH * scale {
                     return None;
                 }
                 for (k, v) in dx.iter().enumerate() {
@@ -241,17 +260,17 @@ impl Refiner<'_> {
                 // on from 1e-6 took 4 rounds each, changed no event by more than 2e-12 in
                 // α and made the trace 35 % slower.)
                 let predicted = if last[j].is_finite() {
-                    step * (step / last[j]) <= CONVERGED * size
+                    step * (step / last[j]) <= CONVERGED * scale
                 } else {
                     step <= FIRST_ROUND * size
                 };
-                if step <= CONVERGED * size || predicted {
+                if step <= CONVERGED * scale || predicted {
                     done[j] = true;
                 } else if step > 0.5 * last[j] {
                     // Refinement that stopped contracting has reached what the residual
                     // in double-double can resolve (~cond · ε²): accepted where that is
                     // still far beyond double.
-                    if step > STALLED * size {
+                    if step > STALLED * scale {
                         return None;
                     }
                     done[j] = true;
@@ -276,15 +295,16 @@ pub(super) struct RefinedPiece {
 
 /// A double-double point `lam2` is taken for the double-precision one `lam` without
 /// further checks only where the two lie within [`NEAR`] of each other (relative to
-/// max|λ|): what double precision gets wrong on a slender body is ~1e-7 at most (in α,
-/// and so in λ along the piece). A larger move means a piece whose point is
-/// ill-determined: the double point, found with the tracer's own checks, is kept, except
-/// by [`Path::polish_point`] where the refined point solves the piece from the data at
-/// least as well.
-pub(super) fn near(lam2: &[f64], lam: &[f64]) -> bool {
+/// max|λ|, or to `floor` where that is larger: the force scale of the data, see
+/// [`Refiner::refine_all`]): what double precision gets wrong on a slender body is ~1e-7
+/// at most (in α, and so in λ along the piece). A larger move means a piece whose point
+/// is ill-determined: the double point, found with the tracer's own checks, is kept,
+/// except by [`Path::polish_point`] where the refined point solves the piece from the
+/// data at least as well.
+pub(super) fn near(lam2: &[f64], lam: &[f64], floor: f64) -> bool {
     let dl: Vec<f64> = lam2.iter().zip(lam).map(|(x, y)| x - y).collect();
     // (a NaN anywhere makes the norms NaN: not near)
-    inf_norm(&dl) <= NEAR * inf_norm(lam)
+    inf_norm(&dl) <= NEAR * inf_norm(lam).max(floor)
 }
 
 impl Path {
@@ -386,7 +406,7 @@ impl Path {
             let yr: Vec<f64> = (0..m).map(|i| x.get(i).to_f64()).collect();
             let wy: Vec<f64> = (0..m).map(|i| (d.get(i) - c.get(i)).to_f64()).collect();
             let finite = yr.iter().chain(&wy).all(|v| v.is_finite());
-            if !finite || !near(&yr, y) {
+            if !finite || !near(&yr, y, r.floor(c)) {
                 return None;
             }
             out.push((yr, wy));
@@ -426,13 +446,14 @@ impl Path {
         // accuracy, rounded (the double q of a general load is a solve with A, off by
         // up to κ(A) ε).
         let qg: Vec<f64> = (0..c.hi.len()).map(|k| c.get(k).to_f64()).collect();
+        let floor = r.floor(&c);
         let (x, d) = r.refine_all(vec![(DdVec::from(lam), c)])?.pop()?;
         let out: Vec<f64> = (0..x.hi.len()).map(|k| x.get(k).to_f64()).collect();
         let d: Vec<f64> = (0..d.hi.len()).map(|k| d.get(k).to_f64()).collect();
         if !out.iter().chain(&d).all(|v| v.is_finite()) {
             return None;
         }
-        if near(&out, lam) {
+        if near(&out, lam, floor) {
             return Some((out, d));
         }
         // Farther from the double-precision point than `near` allows: taken where it
