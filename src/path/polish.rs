@@ -29,14 +29,16 @@ const MAX_ROUNDS: usize = 16;
 /// A first round whose correction is within this fraction of the solution ends the
 /// refinement (see [`Refiner::refine_all`]).
 const FIRST_ROUND: f64 = 1e-4;
-/// A correction this small relative to the solution ends the refinement.
+/// A correction this small relative to the solution's scale (max|x| or the data's force
+/// scale, see [`Refiner::refine_all`]) ends the refinement.
 const CONVERGED: f64 = 1e-24;
-/// A refinement that stops contracting is kept when its last correction is this small.
+/// A refinement that stops contracting is kept when its last correction is this small
+/// (relative to the solution's scale).
 const STALLED: f64 = 1e-20;
-/// A correction larger than this (relative to the solution) ends the refinement as failed:
-/// the guess, a double-precision solution, is then not within cond · ε of the piece's
-/// (garbage from a nearly singular piece). On the p = 1920 strip, cond · ε reaches 1e-4
-/// of λ, and the refinement still contracts by that factor per round.
+/// A correction larger than this (relative to the solution's scale) ends the refinement
+/// as failed: the guess, a double-precision solution, is then not within cond · ε of the
+/// piece's (garbage from a nearly singular piece). On the p = 1920 strip, cond · ε
+/// reaches 1e-4 of λ, and the refinement still contracts by that factor per round.
 const ROUGH: f64 = 1e-2;
 /// See [`near`].
 const NEAR: f64 = 1e-5;
