@@ -236,19 +236,24 @@ fn loads_with_periods_dividing_the_first_step_lose_no_excursion() {
     }
 }
 
-/// The general load `f(α) = f0 + A sin(50 α) f1` of a finite-element case (f itself,
-/// without a derivative).
-fn sine_shear_general(data: &common::Data, amp: f64) -> Load {
+/// The general load `f(α) = f0 + φ(α) f1` of a finite-element case (f itself, without a
+/// derivative).
+fn general_along(data: &common::Data, phi: impl Fn(f64) -> f64 + Send + 'static) -> Load {
     let (g0, g1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
     let n = g0.len();
     let f = Box::new(move |al: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
-        let s = amp * (50.0 * al).sin();
+        let s = phi(al);
         for ((o, a), b) in out.iter_mut().zip(&g0).zip(&g1) {
             *o = a + s * b;
         }
         Ok(())
     });
     Load::general(n, f, None)
+}
+
+/// The general load `f(α) = f0 + A sin(50 α) f1` of a finite-element case.
+fn sine_shear_general(data: &common::Data, amp: f64) -> Load {
+    general_along(data, move |al| amp * (50.0 * al).sin())
 }
 
 /// A finite-element mesh under `f(α) = f0 + A sin(50 α) f1` over three periods: every
@@ -576,23 +581,8 @@ fn a_general_load_locates_the_last_lift_off_from_the_data() {
         last.alpha
     );
 
-    let (f0, f1) = (
-        case.data.f0.as_slice().to_vec(),
-        case.data.f1.as_slice().to_vec(),
-    );
-    let n = f0.len();
-    let f = Box::new(move |a: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
-        for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
-            *o = x + a * y;
-        }
-        Ok(())
-    });
-    let mut path = Path::new(
-        problem,
-        Load::general(n, f, None),
-        PathOptions::window(-2.0, 2.0),
-    )
-    .unwrap();
+    let load = general_along(&case.data, |a| a);
+    let mut path = Path::new(problem, load, PathOptions::window(-2.0, 2.0)).unwrap();
     path.start(-2.0, None).unwrap();
     assert_eq!(path.run().unwrap(), EndReason::Window);
     let got = path.events();
