@@ -317,23 +317,155 @@ pub(crate) fn mat_mul_sub(out: MatMut<'_, f64>, a: MatRef<'_, f64>, b: MatRef<'_
     });
 }
 
-/// `W x` for every x (W square): one pass over W for all of them, on the calling thread
-/// (on the call's pool from order [`PARALLEL_MIN_ORDER`], see [`TracePoolScope`]).
+/// `W x` for every x, W symmetric (m × m, column-major; every W of fricont is symmetric
+/// to the last bit, see `condense::symmetrise` and `problem::equilibrated_w`): one pass
+/// over W's lower triangle for all of them, on the calling thread; on the call's pool
+/// from order [`PARALLEL_MIN_ORDER`] (see [`TracePoolScope`]), a general product. Each x
+/// has m entries. Half of W's bytes and of the loads of x and y of a general product:
+/// one product at m = 960 took 53 µs against faer's general product's 74 µs, and at
+/// m = 3840 (W beyond the caches) 3.2 ms against 4.9 ms, measured in one run.
 pub(crate) fn mat_mul(w: MatRef<'_, f64>, xs: &[&[f64]]) -> Vec<Vec<f64>> {
     let m = w.nrows();
-    let xm = Mat::<f64>::from_fn(m, xs.len(), |i, j| xs[j][i]);
-    let mut out = Mat::<f64>::zeros(m, xs.len());
-    par_kernel(m, |par| {
-        faer::linalg::matmul::matmul(out.as_mut(), faer::Accum::Replace, w, xm.as_ref(), 1.0, par)
-    });
-    (0..xs.len())
-        .map(|j| out.col(j).iter().copied().collect())
-        .collect()
+    debug_assert!(w.ncols() == m && xs.iter().all(|x| x.len() == m));
+    par_kernel(m, |par| match par {
+        Par::Seq => {
+            let mut out = vec![vec![0.0; m]; xs.len()];
+            faer::traits::pulp::Arch::new().dispatch(SymMul {
+                w,
+                xs,
+                out: &mut out,
+            });
+            out
+        }
+        par => {
+            let xm = Mat::<f64>::from_fn(m, xs.len(), |i, j| xs[j][i]);
+            let mut out = Mat::<f64>::zeros(m, xs.len());
+            faer::linalg::matmul::matmul(
+                out.as_mut(),
+                faer::Accum::Replace,
+                w,
+                xm.as_ref(),
+                1.0,
+                par,
+            );
+            (0..xs.len())
+                .map(|j| out.col(j).iter().copied().collect())
+                .collect()
+        }
+    })
+}
+
+/// The lower-triangle kernel of [`mat_mul`]: column j of W below the diagonal is added
+/// to `y[j+1..]` (times `x_j`) and dotted with `x[j+1..]` into `y_j` in one pass.
+struct SymMul<'a> {
+    w: MatRef<'a, f64>,
+    xs: &'a [&'a [f64]],
+    out: &'a mut [Vec<f64>],
+}
+
+impl faer::traits::pulp::WithSimd for SymMul<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn with_simd<S: faer::traits::pulp::Simd>(self, simd: S) {
+        let m = self.w.nrows();
+        let col = |j: usize| {
+            self.w
+                .col(j)
+                .try_as_col_major()
+                .expect("contiguous column")
+                .as_slice()
+        };
+        // Four columns at a time: each load of x and y below them serves four entries of
+        // W (the pass is bound by loads and multiply-adds, not by W's bytes). The last
+        // block may be narrower and has no rows below it.
+        let mut j0 = 0;
+        while j0 < m {
+            let nb = (m - j0).min(4);
+            for (x, y) in self.xs.iter().zip(self.out.iter_mut()) {
+                // The diagonal block: rows j0..j0+nb of columns j0..j0+nb.
+                for j in j0..j0 + nb {
+                    let a = col(j);
+                    y[j] = a[j].mul_add(x[j], y[j]);
+                    for i in j + 1..j0 + nb {
+                        y[i] = a[i].mul_add(x[j], y[i]);
+                        y[j] = a[i].mul_add(x[i], y[j]);
+                    }
+                }
+                let r0 = j0 + nb;
+                if r0 < m {
+                    let a = [0, 1, 2, 3].map(|k| &col(j0 + k)[r0..]);
+                    let (head, yb) = y.split_at_mut(r0);
+                    let sums = below4(simd, a, &x[j0..r0], &x[r0..], yb);
+                    for (h, s) in head[j0..].iter_mut().zip(sums) {
+                        *h += s;
+                    }
+                }
+            }
+            j0 += nb;
+        }
+    }
+}
+
+/// For four columns `a` of W below a diagonal block, with their entries `xj` of x: adds
+/// `Σ_k a_k xj_k` to `y` and returns each `a_k · x`.
+#[inline(always)]
+fn below4<S: faer::traits::pulp::Simd>(
+    simd: S,
+    a: [&[f64]; 4],
+    xj: &[f64],
+    x: &[f64],
+    y: &mut [f64],
+) -> [f64; 4] {
+    let xs = [0, 1, 2, 3].map(|k| simd.splat_f64s(xj[k]));
+    let av = a.map(|a| S::as_simd_f64s(a));
+    let (xv, xt) = S::as_simd_f64s(x);
+    let (yv, yt) = S::as_mut_simd_f64s(y);
+    let mut acc = [simd.splat_f64s(0.0); 4];
+    for (i, (c, b)) in yv.iter_mut().zip(xv).enumerate() {
+        let w = [0, 1, 2, 3].map(|k| av[k].0[i]);
+        let t1 = simd.mul_add_e_f64s(w[1], xs[1], simd.mul_f64s(w[0], xs[0]));
+        let t2 = simd.mul_add_e_f64s(w[3], xs[3], simd.mul_f64s(w[2], xs[2]));
+        *c = simd.add_f64s(*c, simd.add_f64s(t1, t2));
+        for k in 0..4 {
+            acc[k] = simd.mul_add_e_f64s(w[k], *b, acc[k]);
+        }
+    }
+    let mut out = acc.map(|v| simd.reduce_sum_f64s(v));
+    for (i, (c, b)) in yt.iter_mut().zip(xt).enumerate() {
+        for k in 0..4 {
+            let w = av[k].1[i];
+            *c = w.mul_add(xj[k], *c);
+            out[k] = w.mul_add(*b, out[k]);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_symmetric_product_reads_the_lower_triangle_as_the_whole_matrix() {
+        // W_ij = (i + 1)(j + 1) + |i − j| mod 5 − 2 (symmetric, small integers) and
+        // integer x: every sum is exact in double, so the product must equal the naive
+        // row-by-row sum over both triangles exactly. Orders around the 8 lanes; two x
+        // at once.
+        for m in [1usize, 2, 7, 8, 9, 15, 16, 17, 40] {
+            let w = Mat::<f64>::from_fn(m, m, |i, j| {
+                ((i + 1) * (j + 1)) as f64 + (i.abs_diff(j) % 5) as f64 - 2.0
+            });
+            let x1: Vec<f64> = (0..m).map(|i| (i % 7) as f64 - 3.0).collect();
+            let x2: Vec<f64> = (0..m).map(|i| ((3 * i) % 11) as f64 - 5.0).collect();
+            let got = mat_mul(w.as_ref(), &[&x1, &x2]);
+            for (x, y) in [&x1, &x2].into_iter().zip(&got) {
+                for i in 0..m {
+                    let want: f64 = (0..m).map(|j| w[(i, j)] * x[j]).sum();
+                    assert_eq!(y[i], want, "m = {m}, row {i}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn dot_and_abs_dot_sum_every_lane_and_the_tail() {

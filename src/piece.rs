@@ -291,18 +291,12 @@ impl<'a> PieceConstants<'a> {
     }
 }
 
-/// `d = q − (g, 0) + W λ` (one matrix-vector product with faer).
+/// `d = q − (g, 0) + W λ` (one product with the symmetric W, [`crate::dense::mat_mul`]).
 pub(crate) fn displacement_gaps(w: MatRef<'_, f64>, q_minus_g: &[f64], lam: &[f64]) -> Vec<f64> {
-    let m = q_minus_g.len();
-    let mut d = q_minus_g.to_vec();
-    faer::linalg::matmul::matmul(
-        faer::MatMut::from_column_major_slice_mut(&mut d, m, 1),
-        faer::Accum::Add,
-        w,
-        MatRef::from_column_major_slice(lam, lam.len(), 1),
-        1.0,
-        faer::Par::Seq,
-    );
+    let mut d = crate::dense::mat_mul(w, &[lam]).pop().expect("one column");
+    for (di, qi) in d.iter_mut().zip(q_minus_g) {
+        *di += qi;
+    }
     d
 }
 
