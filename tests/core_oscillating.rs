@@ -628,3 +628,64 @@ fn dips_through_zero_within_the_threshold_are_transitions() {
         }
     }
 }
+
+/// A gap closing at a grazing slope under a general load: on a slender strip (F = 5) under
+/// `f0 + φ(α) f1`, φ = −2 cos 5α, node 190 (1-based) touches down at φ = 1.29396 on the
+/// affine path, while node 10 sticks at φ = 1.29352. There, node 190's gap was 4.6e-12
+/// against a threshold of 6.4e-10 (a general load's thresholds hold the load's change
+/// over the window, 2.5 in α here), and its root 2.1e-5 away along the tangent: it was
+/// counted at zero, and touched down with node 10, 4.4e-4 in φ early, without an error.
+/// Reference: the affine path in φ (the reference tracer), mapped through φ; the first
+/// rise of φ, from −2 to 1.35, on the window of two periods.
+#[test]
+fn a_general_load_does_not_merge_a_grazing_touchdown_into_another_transition() {
+    let (amp, omega) = (2.0f64, 5.0f64);
+    let phi = move |a: f64| -amp * (omega * a).cos();
+    let mut case = common::fe_strip(5, 200, 2, 5.0, 10.0, 0.1);
+    (case.a0, case.a1) = (-amp, amp);
+    let problem = Arc::new(case.data.problem());
+    let c = common::reference::compare_case(&case, problem.clone(), 1e-9);
+    c.check(1e-9).unwrap_or_else(|e| panic!("affine: {e}"));
+    let stop = 1.35;
+    let want: Vec<_> = c
+        .reference
+        .events
+        .iter()
+        .filter(|e| e.alpha <= stop)
+        .collect();
+    // the two events of the case, 4.4e-4 apart in φ on the reference
+    let at = |node: usize| {
+        want.iter()
+            .find(|e| e.node == node && e.alpha > 1.29 && e.alpha < 1.3)
+            .unwrap_or_else(|| panic!("node {} near φ = 1.29", node + 1))
+            .alpha
+    };
+    assert!(at(189) - at(9) > 4e-4, "{} {}", at(189), at(9));
+
+    let load = general_along(&case.data, phi);
+    let a1 = 4.0 * PI / omega;
+    let mut path = Path::new(problem, load, PathOptions::window(0.0, a1)).unwrap();
+    path.start(0.0, None).unwrap();
+    // up to φ = stop on the first rise (α < π/ω)
+    let a_stop = (-stop / amp).acos() / omega;
+    while path.events().last().is_none_or(|e| e.alpha <= a_stop) {
+        path.step().unwrap();
+    }
+    let got: Vec<_> = path.events().iter().filter(|e| e.alpha <= a_stop).collect();
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.iter().zip(&want) {
+        let gp = phi(g.alpha);
+        assert!(
+            (g.node, g.from, g.to) == (w.node, w.from, w.to) && (gp - w.alpha).abs() <= 1e-8,
+            "event {}: φ {gp} node {} {:?} → {:?}, the reference's φ {} node {} {:?} → {:?}",
+            g.index,
+            g.node + 1,
+            g.from,
+            g.to,
+            w.alpha,
+            w.node + 1,
+            w.from,
+            w.to
+        );
+    }
+}

@@ -12,11 +12,6 @@ pub(super) const MAX_WIDENING: f64 = 64.0;
 /// along one of them, across pieces a rounding long, is not a branch).
 const RETRACE_LOOKBACK: usize = 4;
 
-/// A piece "a rounding long" for `transit`: α and the contact forces change by at most this
-/// fraction along it (mirrored nodes of a symmetric body in double switch up to 1e-9
-/// apart).
-const ROUNDING_LONG: f64 = 1e-8;
-
 /// A bound on how far the data determine q, relative to the load's terms
 /// ([`Path::undetermined_fit`]): the condensation's relative error, about κ(A) ε, is below
 /// it wherever A is well enough conditioned for double.

@@ -320,6 +320,10 @@ pub(super) struct Tol {
     /// An open node's `λt = 0` judged against F times its threshold ([`Widen::cone`],
     /// [`Tol::cone_factor`]; false otherwise).
     cone: bool,
+    /// The rows' terms are estimated (a general load, see [`Path::term_rows`]): a guard
+    /// approaching zero is at zero by its value only where its own root lies within
+    /// [`ROUNDING_LONG`] along the tangent (see [`Tol::at_zero`]).
+    estimated: bool,
 }
 
 /// How the thresholds of `join::transit`'s retries differ from the usual ones
@@ -362,6 +366,12 @@ impl Widen {
 /// The rounding of a guard's value at an exactly computed point, as a fraction of
 /// [`Tol::of`].
 const ROUNDING: f64 = 1e-2;
+
+/// A piece "a rounding long" for `join::transit`: α and the contact forces change by at
+/// most this fraction along it (mirrored nodes of a symmetric body in double switch up to
+/// 1e-9 apart). Also how near a guard's own root must lie for [`Tol::at_zero`] to count
+/// it at zero by its value where the thresholds are estimated.
+const ROUNDING_LONG: f64 = 1e-8;
 
 /// The per-row thresholds of displacement forms, computed on first use: row k costs one
 /// pass over row k of W (`(|W| |λ|)_k`), so a transition pays only for the rows it asks.
@@ -465,6 +475,7 @@ impl Tol {
             min_row: 0.0,
             determined: 0.0,
             cone: false,
+            estimated: false,
         }
     }
 
@@ -531,11 +542,24 @@ impl Tol {
     /// A guard that is small against its terms but crosses zero a distinct step away (on
     /// slender bodies the contact forces are a thousandth of the load's scale, and their
     /// guards' slopes tiny) is not at zero: it has its own transition.
+    ///
+    /// Where the terms are estimated (a general load), the thresholds hold the load's
+    /// change over the window and can be far above the value's rounding: there, at a
+    /// point found exactly (not a start, whose values are the fixed-α solver's), a
+    /// positive guard that decreases is at zero by its value only where its own root lies
+    /// within [`ROUNDING_LONG`] along the tangent (a relative change of the forces and of
+    /// α in its unit). A gap closing at a grazing slope (4.6e-12 against a threshold of
+    /// 6.4e-10, its root 2.1e-5 away) was counted at zero at another node's transition,
+    /// and the node touched down there, 4.4e-4 in φ before its own root, without an error.
     fn at_zero(&self, f: &crate::piece::LinForm, v: f64, vd: f64) -> bool {
         let a = v.abs();
+        let own_root =
+            self.estimated && self.rounding < 1.0 && v > 0.0 && vd < 0.0 && a > ROUNDING_LONG * -vd;
         a.is_finite()
             && ((vd.is_finite() && a <= self.arc * vd.abs())
-                || (a <= self.rounding * self.upper(f) && a <= self.rounding * self.of(f)))
+                || (!own_root
+                    && a <= self.rounding * self.upper(f)
+                    && a <= self.rounding * self.of(f)))
     }
 
     /// An upper bound of [`Self::of`] that costs O(1): a value above it is above the
@@ -958,6 +982,7 @@ impl Path {
             min_row: 0.0,
             determined: 0.0,
             cone: false,
+            estimated: self.load.term_magnitude_rows(pt.alpha).is_none(),
         };
         self.tol_cache.put(pt.alpha, &pt.lam, tol.clone());
         tol
