@@ -355,8 +355,9 @@ pub(crate) fn mat_mul(w: MatRef<'_, f64>, xs: &[&[f64]]) -> Vec<Vec<f64>> {
     })
 }
 
-/// The lower-triangle kernel of [`mat_mul`]: column j of W below the diagonal is added
-/// to `y[j+1..]` (times `x_j`) and dotted with `x[j+1..]` into `y_j` in one pass.
+/// The lower-triangle kernel of [`mat_mul`]: each column j of W below the diagonal is
+/// added to `y[j+1..]` (times `x_j`) and dotted with `x[j+1..]` into `y_j` in one pass,
+/// four columns at a time (see [`below4`]).
 struct SymMul<'a> {
     w: MatRef<'a, f64>,
     xs: &'a [&'a [f64]],
