@@ -646,17 +646,24 @@ impl Path {
         let (lo, hi) = self.window();
         let bound = if dir > 0.0 { hi } else { lo };
         let span = self.alpha_scale();
-        // M_S solves: by the piece's updated factorisation, or one LU of M_S.
-        let dense = match &*cur.lu {
-            PieceSolver::Updated(_) => None,
-            PieceSolver::Full(_) => {
-                let c = self.consts();
-                Some(DenseLu::new(
-                    c.piece_matrix(self.problem.delassus().w(), &cur.classes)
-                        .as_ref(),
-                ))
-            }
+        // M_S solves: by the piece's updated factorisation, or one LU of M_S. Where an
+        // updated solve fails its check from the data (a relative residual above 1e-12),
+        // the march goes on with one LU of M_S instead, from that evaluation on (its
+        // solves at neighbouring α then share one factorisation). On a slender strip
+        // (F = 5) a piece entered after ten updates (pivot ratio 2e-6) was solved to a
+        // residual of 1.9e-9 at its entry: λ was wrong by more than its size, its
+        // refinement in double-double failed, and the march stopped with an error.
+        let piece_lu = |this: &Self| {
+            let c = this.consts();
+            DenseLu::new(
+                c.piece_matrix(this.problem.delassus().w(), &cur.classes)
+                    .as_ref(),
+            )
         };
+        let dense = std::cell::OnceCell::new();
+        if let PieceSolver::Full(_) = &*cur.lu {
+            let _ = dense.set(piece_lu(self));
+        }
         let add =
             |a: &[f64], b: &[f64]| -> Vec<f64> { a.iter().zip(b).map(|(x, y)| x + y).collect() };
         // λ, d, dλ/dα and the rate of d along (dλ/dα, 1) from solves with M_S: both
@@ -665,18 +672,21 @@ impl Path {
             let c = this.consts();
             let w = this.problem.delassus().w();
             let rhs = [c.piece_rhs(&cur.classes, qg), c.piece_rhs(&cur.classes, dq)];
-            let (xs, wxs) = match (&dense, &*cur.lu) {
-                (Some(lu), _) => {
-                    let xs: Vec<Vec<f64>> = rhs.iter().map(|b| lu.solve(b)).collect();
-                    let wxs = crate::dense::mat_mul(w, &[&xs[0], &xs[1]]);
-                    (xs, wxs)
-                }
+            let by_lu = |lu: &DenseLu| {
+                let xs: Vec<Vec<f64>> = rhs.iter().map(|b| lu.solve(b)).collect();
+                let wxs = crate::dense::mat_mul(w, &[&xs[0], &xs[1]]);
+                (xs, wxs)
+            };
+            let (xs, wxs) = match (dense.get(), &*cur.lu) {
+                (Some(lu), _) => by_lu(lu),
                 (None, PieceSolver::Updated(u)) => {
                     let cols = rhs.each_ref().map(|b| update::Rhs { b, guess: None });
-                    u.solve_checked_many(&c, w, &cols, this.row_bound())
-                        .into_iter()
-                        .map(|k| (k.x, k.wx))
-                        .unzip()
+                    let ks = u.solve_checked_many(&c, w, &cols, this.row_bound());
+                    if ks.iter().all(|k| k.rel <= 1e-12) {
+                        ks.into_iter().map(|k| (k.x, k.wx)).unzip()
+                    } else {
+                        by_lu(dense.get_or_init(|| piece_lu(this)))
+                    }
                 }
                 (None, PieceSolver::Full(_)) => unreachable!("a full solver has its dense LU"),
             };
