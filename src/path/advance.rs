@@ -349,6 +349,45 @@ impl Path {
         self.point_at(lam, alpha)
     }
 
+    /// The point `pt` where a piece ends at the zero of guard `g`, moved along the piece's
+    /// tangent to that zero where α cannot resolve it: λ and d by the Newton step, α by
+    /// it rounded. `(t, rate)`: dλ/dα and dd/dα at `pt`; `within`: the stretch of α the
+    /// root was found on, and `max_step` the longest step in α taken (a step beyond either
+    /// is not taken: a general load's guards far above their thresholds at scales near
+    /// the largest double asked for a step of 7e-3 in α). Near a fold the guard's slope
+    /// per unit α was 1e4 (basis load): neighbouring doubles of α straddled its zero at
+    /// ±2.5e-14; on a piece with dα/ds = 3.9e-5 (general load, slender strip, F = 5) the
+    /// normal force of the node lifting off was −4.5e-12 at the root's double, 1.7 times
+    /// its threshold, and no piece continued the path. Moved where the guard is beyond a
+    /// quarter of its threshold (for a normal force, that over F: from slip, λt = ±F λν
+    /// follows it, and the classes the node may take bound λt by the same threshold).
+    fn onto_guard_zero(
+        &mut self,
+        pt: Point,
+        g: Guard,
+        (t, rate): (&[f64], &[f64]),
+        (lo, hi): (f64, f64),
+        max_step: f64,
+    ) -> Result<Point> {
+        let c = self.consts();
+        let form = c.guard_form(g);
+        let amplified = match g.kind {
+            crate::piece::GuardKind::Compress => c.friction[g.node].max(1.0),
+            _ => 1.0,
+        };
+        let accept = 0.25 * self.tol_at(&pt).of(&form) / amplified;
+        let d = self.gaps(&pt);
+        let v = form.eval(&pt.lam, &d);
+        if v.abs() <= accept {
+            return Ok(pt);
+        }
+        let step = -v / form.eval(t, rate);
+        if !(step.is_finite() && step.abs() <= max_step && (lo..=hi).contains(&(pt.alpha + step))) {
+            return Ok(pt);
+        }
+        self.step_along(pt.alpha, (&pt.lam, &d), (t, rate), step)
+    }
+
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
     /// with the rate of d along it (`W t_λ + q' t_α`, see [`Path::rate_along`]).
     pub(super) fn guard_table(
@@ -1238,25 +1277,26 @@ impl Path {
                         eval(self, p.alpha, true)?.0
                     };
                 }
-                // Where α cannot resolve the root (near a fold the guard's slope per unit
-                // α was 1e4: neighbouring doubles of α straddled it at ±2.5e-14, above
-                // `accept`), the point is moved along the piece's tangent to the guard's
-                // zero, λ and d by the Newton step, α by it rounded.
-                let d = self.gaps(&pt);
-                let v = form.eval(&pt.lam, &d);
-                if v.abs() > accept
-                    && let Some((w, dw)) = self.load.weights_at(pt.alpha)
-                {
+                if let Some((w, dw)) = self.load.weights_at(pt.alpha) {
                     let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
                     let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
-                    let step = -v / form.eval(&t, &rate);
-                    if step.is_finite() && (lo_a..=hi_a).contains(&(pt.alpha + step)) {
-                        pt = self.step_along(pt.alpha, (&pt.lam, &d), (&t, &rate), step)?;
-                    }
+                    pt = self.onto_guard_zero(pt, g, (&t, &rate), (lo_a, hi_a), f64::INFINITY)?;
                 }
                 if let Some(p) = self.polish_root(cur, bs, (k, slope), (lo_a, hi_a), &pt)? {
                     pt = p;
                 }
+            } else if basis.is_none() {
+                // A general load's root, in α, as above, by a step of a few roundings of
+                // α at most (where α cannot resolve it; its root was found in α).
+                let from = match &behind {
+                    Some((a_prev, _)) if before => *a_prev,
+                    _ => pa.alpha,
+                };
+                let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+                let [_, _, t, rate] = solve(self, &qg, &pt.dq);
+                let within = (from.min(pb.alpha), from.max(pb.alpha));
+                let max_step = 4.0 * f64::EPSILON * pt.alpha.abs();
+                pt = self.onto_guard_zero(pt, g, (&t, &rate), within, max_step)?;
             }
             return Ok(Exit::Guards(pt, vec![g]));
         }
