@@ -351,7 +351,8 @@ impl Path {
 
     /// The point `pt` where a piece ends at the zero of guard `g`, moved along the piece's
     /// tangent to that zero where α cannot resolve it: λ and d by the Newton step, α by
-    /// it rounded. `(t, rate)`: dλ/dα and dd/dα at `pt`; `within`: the stretch of α the
+    /// it rounded. `tangent`: dλ/dα and dd/dα at `pt` (computed only where the point
+    /// moves; None: it stays); `within`: the stretch of α the
     /// root was found on, and `max_step` the longest step in α taken (a step beyond either
     /// is not taken: a general load's guards far above their thresholds at scales near
     /// the largest double asked for a step of 7e-3 in α). Near a fold the guard's slope
@@ -365,7 +366,7 @@ impl Path {
         &mut self,
         pt: Point,
         g: Guard,
-        (t, rate): (&[f64], &[f64]),
+        tangent: impl FnOnce(&Self, &Point) -> Option<[Vec<f64>; 2]>,
         (lo, hi): (f64, f64),
         max_step: f64,
     ) -> Result<Point> {
@@ -381,11 +382,14 @@ impl Path {
         if v.abs() <= accept {
             return Ok(pt);
         }
-        let step = -v / form.eval(t, rate);
+        let Some([t, rate]) = tangent(self, &pt) else {
+            return Ok(pt);
+        };
+        let step = -v / form.eval(&t, &rate);
         if !(step.is_finite() && step.abs() <= max_step && (lo..=hi).contains(&(pt.alpha + step))) {
             return Ok(pt);
         }
-        self.step_along(pt.alpha, (&pt.lam, &d), (t, rate), step)
+        self.step_along(pt.alpha, (&pt.lam, &d), (&t, &rate), step)
     }
 
     /// Values and derivatives along `t` of all guards of `classes` at `pt`; `t` comes
@@ -1277,11 +1281,13 @@ impl Path {
                         eval(self, p.alpha, true)?.0
                     };
                 }
-                if let Some((w, dw)) = self.load.weights_at(pt.alpha) {
-                    let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
+                let tangent = |this: &Self, pt: &Point| {
+                    let (w, dw) = this.load.weights_at(pt.alpha)?;
+                    let qg = shift_gap(&pt.q, this.problem.gap_equilibrated());
                     let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
-                    pt = self.onto_guard_zero(pt, g, (&t, &rate), (lo_a, hi_a), f64::INFINITY)?;
-                }
+                    Some([t, rate])
+                };
+                pt = self.onto_guard_zero(pt, g, tangent, (lo_a, hi_a), f64::INFINITY)?;
                 if let Some(p) = self.polish_root(cur, bs, (k, slope), (lo_a, hi_a), &pt)? {
                     pt = p;
                 }
@@ -1292,11 +1298,14 @@ impl Path {
                     Some((a_prev, _)) if before => *a_prev,
                     _ => pa.alpha,
                 };
-                let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
-                let [_, _, t, rate] = solve(self, &qg, &pt.dq);
+                let tangent = |this: &Self, pt: &Point| {
+                    let qg = shift_gap(&pt.q, this.problem.gap_equilibrated());
+                    let [_, _, t, rate] = solve(this, &qg, &pt.dq);
+                    Some([t, rate])
+                };
                 let within = (from.min(pb.alpha), from.max(pb.alpha));
                 let max_step = 4.0 * f64::EPSILON * pt.alpha.abs();
-                pt = self.onto_guard_zero(pt, g, (&t, &rate), within, max_step)?;
+                pt = self.onto_guard_zero(pt, g, tangent, within, max_step)?;
             }
             return Ok(Exit::Guards(pt, vec![g]));
         }
