@@ -349,6 +349,19 @@ impl Path {
         self.point_at(lam, alpha)
     }
 
+    /// How near zero guard `g` must be at `pt` for a root the piece ends at: a quarter of
+    /// its threshold; for a normal force, that over F (from slip, λt = ±F λν follows it,
+    /// and the classes the node may take bound λt by the same threshold: with F = 5, λν
+    /// at 0.65 of it left λt beyond the open class's, and no piece continued the path).
+    fn root_accept(&self, pt: &Point, g: Guard) -> f64 {
+        let c = self.consts();
+        let amplified = match g.kind {
+            crate::piece::GuardKind::Compress => c.friction[g.node].max(1.0),
+            _ => 1.0,
+        };
+        0.25 * self.tol_at(pt).of(&c.guard_form(g)) / amplified
+    }
+
     /// The point `pt` where a piece ends at the zero of guard `g`, moved along the piece's
     /// tangent to that zero where α cannot resolve it: λ and d by the Newton step, α by
     /// it rounded. `tangent`: dλ/dα and dd/dα at `pt` (computed only where the point
@@ -359,9 +372,8 @@ impl Path {
     /// per unit α was 1e4 (basis load): neighbouring doubles of α straddled its zero at
     /// ±2.5e-14; on a piece with dα/ds = 3.9e-5 (general load, slender strip, F = 5) the
     /// normal force of the node lifting off was −4.5e-12 at the root's double, 1.7 times
-    /// its threshold, and no piece continued the path. Moved where the guard is beyond a
-    /// quarter of its threshold (for a normal force, that over F: from slip, λt = ±F λν
-    /// follows it, and the classes the node may take bound λt by the same threshold).
+    /// its threshold, and no piece continued the path. Moved where the guard is beyond
+    /// [`Self::root_accept`].
     fn onto_guard_zero(
         &mut self,
         pt: Point,
@@ -370,16 +382,10 @@ impl Path {
         (lo, hi): (f64, f64),
         max_step: f64,
     ) -> Result<Point> {
-        let c = self.consts();
-        let form = c.guard_form(g);
-        let amplified = match g.kind {
-            crate::piece::GuardKind::Compress => c.friction[g.node].max(1.0),
-            _ => 1.0,
-        };
-        let accept = 0.25 * self.tol_at(&pt).of(&form) / amplified;
+        let form = self.consts().guard_form(g);
         let d = self.gaps(&pt);
         let v = form.eval(&pt.lam, &d);
-        if v.abs() <= accept {
+        if v.abs() <= self.root_accept(&pt, g) {
             return Ok(pt);
         }
         let Some([t, rate]) = tangent(self, &pt) else {
@@ -1185,6 +1191,12 @@ impl Path {
             // more than the join's tolerance.) A Newton step from the root, taken where
             // the guard is well inside the join's tolerance there, else a bracket about
             // it and Brent; the point that ends the piece is checked from the data.
+            // The stretch of α the root was found on.
+            let from = match &behind {
+                Some((a_prev, _)) if before => *a_prev,
+                _ => pa.alpha,
+            };
+            let (lo_a, hi_a) = (from.min(pb.alpha), from.max(pb.alpha));
             if let Some(bs) = &basis
                 && let Some(k) = tab.iter().position(|r| r.guard == g)
                 && let Some((w_r, _)) = self.load.weights_at(root)
@@ -1210,26 +1222,9 @@ impl Path {
                     let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
                     Ok((Point { lam, ..at }, table))
                 };
-                let from = match &behind {
-                    Some((a_prev, _)) if before => *a_prev,
-                    _ => pa.alpha,
-                };
-                let (lo_a, hi_a) = (from.min(pb.alpha), from.max(pb.alpha));
                 let (mut x0, mut v0) = (root, tab[k].value);
                 let slope = tab[k].slope;
-                // A quarter of the guard's threshold; for a normal force, that over F:
-                // from slip, λt = ±F λν follows it, and the classes the node may take
-                // bound λt by the same threshold (with F = 5, λν at 0.65 of it left λt
-                // beyond the open class's, and no piece continued the path).
-                let (form, amplified) = {
-                    let c = self.consts();
-                    let f = match g.kind {
-                        crate::piece::GuardKind::Compress => c.friction[g.node].max(1.0),
-                        _ => 1.0,
-                    };
-                    (c.guard_form(g), f)
-                };
-                let accept = 0.25 * self.tol_at(&pt).of(&form) / amplified;
+                let accept = self.root_accept(&pt, g);
                 let mut bracket = None;
                 let mut best: Option<Point> = None;
                 let mut step = -v0 / slope;
@@ -1294,18 +1289,13 @@ impl Path {
             } else if basis.is_none() {
                 // A general load's root, in α, as above, by a step of a few roundings of
                 // α at most (where α cannot resolve it; its root was found in α).
-                let from = match &behind {
-                    Some((a_prev, _)) if before => *a_prev,
-                    _ => pa.alpha,
-                };
                 let tangent = |this: &Self, pt: &Point| {
                     let qg = shift_gap(&pt.q, this.problem.gap_equilibrated());
                     let [_, _, t, rate] = solve(this, &qg, &pt.dq);
                     Some([t, rate])
                 };
-                let within = (from.min(pb.alpha), from.max(pb.alpha));
                 let max_step = 4.0 * f64::EPSILON * pt.alpha.abs();
-                pt = self.onto_guard_zero(pt, g, tangent, within, max_step)?;
+                pt = self.onto_guard_zero(pt, g, tangent, (lo_a, hi_a), max_step)?;
             }
             return Ok(Exit::Guards(pt, vec![g]));
         }
