@@ -673,7 +673,7 @@ fn dips_through_zero_within_the_threshold_are_transitions() {
 /// rise of φ, from −2 to 1.35, on the window of two periods.
 #[test]
 fn a_general_load_does_not_merge_a_grazing_touchdown_into_another_transition() {
-    let (amp, omega) = (2.0f64, 5.0f64);
+    let (amp, omega) = (WALK_AMP, WALK_OMEGA);
     let phi = move |a: f64| -amp * (omega * a).cos();
     let mut case = common::fe_strip(5, 200, 2, 5.0, 10.0, 0.1);
     (case.a0, case.a1) = (-amp, amp);
