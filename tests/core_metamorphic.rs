@@ -3,7 +3,8 @@
 //!
 //! * Far window ends: moving only the far end of the window (to 1e3 … 1e12) leaves the
 //!   start and every event inside the original window unchanged — the original events
-//!   are a prefix of the far-window events.
+//!   are a prefix of the far-window events (for nonlinear loads, against the affine
+//!   path through φ).
 //! * Global force scaling: `f ↦ s f`, `g ↦ s g` (s = 1e-9 … 1e9) gives the same α and
 //!   `λ ↦ s λ`.
 //! * Global stiffness scaling: `A ↦ s A`, `g ↦ g / s` gives the same α and λ.
@@ -146,6 +147,149 @@ fn far_window_ends_random() {
             assert_prefix(&ctx, base.events(), path.events(), 1e-11);
         }
     }
+}
+
+/// φ(α) = α + 0.2 sin 2α (increasing: φ' ≥ 0.6), the nonlinear loads' weight of f1.
+fn phi(a: f64) -> f64 {
+    a + 0.2 * (2.0 * a).sin()
+}
+
+fn dphi(a: f64) -> f64 {
+    1.0 + 0.4 * (2.0 * a).cos()
+}
+
+/// `f0 + φ(α) f1` as a basis load (`basis`) or a general load, failing (the host's error)
+/// strictly beyond `fail = (α_f, direction)`: a path with a far window end stops there.
+fn nonlinear_load(data: &Data, basis: bool, fail: Option<(f64, f64)>) -> fricont::Load {
+    use fricont::load::LoadFailure;
+    let beyond = move |a: f64| -> Result<(), LoadFailure> {
+        match fail {
+            Some((at, dir)) if dir * (a - at) > 0.0 => Err(LoadFailure {
+                code: 1,
+                message: "beyond the compared window".into(),
+            }),
+            _ => Ok(()),
+        }
+    };
+    let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
+    if basis {
+        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+            beyond(a)?;
+            (w[0], w[1], dw[0], dw[1]) = (1.0, phi(a), 0.0, dphi(a));
+            Ok(())
+        };
+        return fricont::Load::basis(vec![f0, f1], Box::new(weights)).unwrap();
+    }
+    let df1 = f1.clone();
+    fricont::Load::general(
+        f0.len(),
+        Box::new(move |a: f64, out: &mut [f64]| {
+            beyond(a)?;
+            for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+                *o = x + phi(a) * y;
+            }
+            Ok(())
+        }),
+        Some(Box::new(move |a: f64, out: &mut [f64]| {
+            for (o, y) in out.iter_mut().zip(&df1) {
+                *o = dphi(a) * y;
+            }
+            Ok(())
+        })),
+    )
+}
+
+/// Far window ends under nonlinear loads: `f0 + φ(α) f1` (φ = α + 0.2 sin 2α, as a basis
+/// and as a general load) on random problems and finite-element meshes, traced over the
+/// case's window and over windows whose far end is 1e3, 1e8 and 1e12 away (the load fails
+/// half a window past the original end, which stops those paths). Every event inside the
+/// original window must be the affine path's (over [φ(α0), φ(α1)], an independent trace:
+/// no march, no nonlinear thresholds) at φ⁻¹ of its α, to 1e-12. The march's least step
+/// and a general load's estimated thresholds were fractions of the window's length: at
+/// 1e12 the general load reported wrong events without an error (every guard counted as
+/// at zero) and the basis load stopped loudly (steps of length 1 past the step control).
+#[test]
+fn far_window_ends_of_nonlinear_loads() {
+    let inv_phi = |p: f64| {
+        let mut a = p;
+        for _ in 0..60 {
+            a -= (phi(a) - p) / dphi(a);
+        }
+        a
+    };
+    let cases = (0..40u64).map(random_case).chain((0..8u64).map(|s| {
+        common::fe_case(
+            s,
+            6 + 3 * s as usize,
+            1 + (s % 3) as usize,
+            [0.3, 1.5, 5.0][s as usize % 3],
+        )
+    }));
+    let (mut worst, mut events) = (0.0f64, 0);
+    for case in cases {
+        let (data, a0, a1) = (&case.data, case.a0, case.a1);
+        let dir = (a1 - a0).signum();
+        let affine = run(data, phi(a0), phi(a1));
+        let want: Vec<(f64, NodeChange)> = affine
+            .events()
+            .iter()
+            .map(|e| (inv_phi(e.alpha), (e.node, e.from, e.to)))
+            .collect();
+        for basis in [false, true] {
+            for far in [None, Some(1e3), Some(1e8), Some(1e12)] {
+                let ctx = format!(
+                    "seed {} (p = {}), basis {basis}, far end {far:?}",
+                    case.seed, data.p
+                );
+                let (end, fail) = match far {
+                    None => (a1, None),
+                    Some(f) => (a0 + dir * f, Some((a1 + 0.5 * (a1 - a0), dir))),
+                };
+                let load = nonlinear_load(data, basis, fail);
+                let mut path = Path::new(
+                    Arc::new(data.problem()),
+                    load,
+                    fricont::PathOptions::window(a0, end),
+                )
+                .unwrap();
+                path.start(a0, None)
+                    .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
+                loop {
+                    match path.step() {
+                        Ok(fricont::StepOutcome::End(_)) => break,
+                        Ok(_) => {}
+                        Err(fricont::Error::Load { .. }) if far.is_some() => break,
+                        Err(e) => panic!("{ctx}: {e}"),
+                    }
+                }
+                let got = path.events();
+                events += want.len();
+                assert!(
+                    got.len() >= want.len(),
+                    "{ctx}: {} events, want {}",
+                    got.len(),
+                    want.len()
+                );
+                for (k, (w, g)) in want.iter().zip(got).enumerate() {
+                    worst = worst.max((w.0 - g.alpha).abs() / w.0.abs().max(1.0));
+                    assert!(
+                        w.1 == (g.node, g.from, g.to) && close(w.0, g.alpha, 1e-12),
+                        "{ctx}: event {k}: α {} node {} {:?} → {:?}, the affine path's at α {} node {} {:?} → {:?}",
+                        g.alpha,
+                        g.node + 1,
+                        g.from,
+                        g.to,
+                        w.0,
+                        w.1.0 + 1,
+                        w.1.1,
+                        w.1.2
+                    );
+                }
+            }
+        }
+    }
+    eprintln!("{events} events, worst relative difference in α {worst:e}");
+    assert!(events >= 2000, "{events} events");
 }
 
 #[test]

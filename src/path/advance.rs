@@ -97,7 +97,8 @@ pub(super) struct GuardRow {
     pub(super) slope: f64,
 }
 
-/// Most consecutive steps of at most `hmin` (1e-12 of the window) that a march along one
+/// Most consecutive steps of at most `hmin` (1e-12 of the window, or of the load's own α
+/// length where the window is far longer, see `Path::load_span`) that a march along one
 /// piece of a nonlinear load takes before it stops with an error: such steps skip the step
 /// control, and a march that takes nothing longer has stalled.
 const MAX_FORCED_STEPS: usize = 1000;
@@ -694,7 +695,6 @@ impl Path {
         let dir = if cur.t[m] > 0.0 { 1.0 } else { -1.0 };
         let (lo, hi) = self.window();
         let bound = if dir > 0.0 { hi } else { lo };
-        let span = self.alpha_scale();
         // M_S solves: by the piece's updated factorisation, or one LU of M_S. Where an
         // updated solve fails its check from the data (a relative residual above 1e-12),
         // the march goes on with one LU of M_S instead, from that evaluation on (its
@@ -807,9 +807,12 @@ impl Path {
             Ok((pt, table))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
+        let span = self.load_span(&pa);
         // The start of the step before `pa` and its guards (None on the first step).
         let mut behind: Option<(f64, Vec<GuardRow>)> = None;
-        let hmax = self.opts.max_alpha_step.unwrap_or(span / 8.0);
+        // (the default largest step is 1/8 of the window itself, as documented: a step
+        // reached by doubling trusted ones)
+        let hmax = self.opts.max_alpha_step.unwrap_or(self.alpha_scale() / 8.0);
         // The first piece's march starts short and doubles its way up: a step trusted by
         // its midpoint can alias the load's period only when it spans whole periods, and
         // one reached by doubling a trusted step cannot (its half was trusted). A first
@@ -834,7 +837,7 @@ impl Path {
         let mut below: Option<Vec<bool>> = None;
         let mut ahead: Option<(Point, Vec<GuardRow>)> = None;
         // Consecutive steps taken at h ≤ hmin, where the step control is skipped: a march
-        // that can take no longer step crawls at 1e-12 of the window and never ends.
+        // that can take no longer step crawls at 1e-12 of the span and never ends.
         let mut forced = 0usize;
         loop {
             let tol = {
@@ -1016,7 +1019,7 @@ impl Path {
                 forced += 1;
                 if forced > MAX_FORCED_STEPS {
                     return Err(Error::Numerical(format!(
-                        "the march along a piece of the nonlinear load stalled at alpha = {:e}: {MAX_FORCED_STEPS} steps in a row of at most 1e-12 of the window passed no step control{}",
+                        "the march along a piece of the nonlinear load stalled at alpha = {:e}: {MAX_FORCED_STEPS} steps in a row of at most 1e-12 of the window (of the load's own α scale for a far window) passed no step control{}",
                         pa.alpha,
                         near_overflow(&pa)
                     )));

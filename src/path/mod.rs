@@ -373,6 +373,12 @@ const ROUNDING: f64 = 1e-2;
 /// it at zero by its value where the thresholds are estimated.
 const ROUNDING_LONG: f64 = 1e-8;
 
+/// Most that the window's length counts for a nonlinear load beyond the point's own α
+/// length (see [`Path::load_span`]): windows up to a thousand times that scale trace as
+/// the window's length says (the suites' windows, and far windows up to 1e3 of the load's
+/// scale, traced the same events either way).
+const FAR_WINDOW: f64 = 1e3;
+
 /// The per-row thresholds of displacement forms, computed on first use: row k costs one
 /// pass over row k of W (`(|W| |λ|)_k`), so a transition pays only for the rows it asks.
 #[derive(Debug)]
@@ -927,12 +933,35 @@ impl Path {
         scale
     }
 
+    /// The α length that a nonlinear load's march (its first and its shortest steps) and a
+    /// general load's estimated term magnitudes ([`Self::term_rows`]) are relative to at
+    /// `pt`: the window's length, but at most [`FAR_WINDOW`] times the
+    /// point's own α length, `max(|α − α_start|, ‖q‖∞ / ‖q'‖∞)` (how far the path has come,
+    /// and how far α moves the load by its own size; the window's length where both are 0).
+    /// A far window end does not make the thresholds of a general load, or the least step
+    /// of a march, a fixed fraction of the window: with the window's length itself, a
+    /// window [a, 1e12] around a load varying on a scale of 1 made every guard "at zero"
+    /// (a general load: wrong events, no error) or forced steps of length 1 past the step
+    /// control (a basis load: loud stops).
+    fn load_span(&self, pt: &Point) -> f64 {
+        let window = self.alpha_scale();
+        let own = inf_norm(&pt.q) / inf_norm(&pt.dq);
+        // (f64::max ignores a NaN own length, 0 / 0)
+        let local = (pt.alpha - self.opts.alpha_start).abs().max(own);
+        if local.is_finite() && local > 0.0 {
+            window.min(FAR_WINDOW * local)
+        } else {
+            window
+        }
+    }
+
     /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
     /// ([`BoundLoad::term_magnitude_rows`]); for a general load, whose terms are not
-    /// known, `|q_k| + |α_end − α_start| |q'_k|` (the change of q over the window).
+    /// known, `|q_k| + L |q'_k|` (the change of q over an α length L: the window's, but
+    /// no more than a thousand times the point's own, see [`Self::load_span`]).
     fn term_rows(&self, pt: &Point) -> Vec<f64> {
         self.load.term_magnitude_rows(pt.alpha).unwrap_or_else(|| {
-            let span = self.alpha_scale();
+            let span = self.load_span(pt);
             pt.q.iter()
                 .zip(&pt.dq)
                 .map(|(q, dq)| q.abs() + span * dq.abs())
