@@ -98,10 +98,15 @@ pub(super) struct GuardRow {
 }
 
 /// Most consecutive steps of at most `hmin` (1e-12 of the window, or of the load's own α
-/// length where the window is far longer, see `Path::load_span`) that a march along one
-/// piece of a nonlinear load takes before it stops with an error: such steps skip the step
-/// control, and a march that takes nothing longer has stalled.
+/// length where the window is far longer, see `Path::load_span`; at least [`ALPHA_ULPS`]
+/// ulps of α) that a march along one piece of a nonlinear load takes before it stops with
+/// an error: such steps skip the step control, and a march that takes nothing longer has
+/// stalled.
 const MAX_FORCED_STEPS: usize = 1000;
+
+/// The least step of a march, in ulps of α (`hmin` in `Path::exit_graph`): a shorter one
+/// may not move α at all.
+const ALPHA_ULPS: f64 = 8.0;
 
 /// An error unless every guard of `rows` at `pt` is finite: past the range of a double
 /// (forces near 1e308) every comparison with a NaN is false, so no guard would cross and
@@ -827,7 +832,7 @@ impl Path {
             .min(span / 32.0)
             .min(hmax)
             .min((bound - cur.alpha).abs());
-        let hmin = span * 1e-12;
+        let hmin_span = span * 1e-12;
         // Guards below their threshold at the piece's own point at its entry, and rising:
         // the guards the piece was entered through, measured on its own solution, which
         // differs from the transition point by cond · ε (more than the thresholds on the
@@ -840,6 +845,11 @@ impl Path {
         // that can take no longer step crawls at 1e-12 of the span and never ends.
         let mut forced = 0usize;
         loop {
+            // No step below α's own resolution (a few of its ulps): a step that does not
+            // move α, or a root one ulp away whose stretch is halved again and again, never
+            // ends (α near 1e6 on a window of length 7: the march halved a 1.2e-10 stretch
+            // to 5.8e-11 forever).
+            let hmin = hmin_span.max(ALPHA_ULPS * f64::EPSILON * pa.alpha.abs());
             let tol = {
                 let c = self.consts();
                 let forms = ga.iter().map(|row| c.guard_form(row.guard)).collect();
@@ -851,7 +861,11 @@ impl Path {
                     .collect()
             });
             let at_bound = (bound - pa.alpha).abs() <= h;
-            let b_alpha = if at_bound { bound } else { pa.alpha + dir * h };
+            let b_alpha = if at_bound {
+                bound
+            } else {
+                pa.alpha + dir * h.max(hmin)
+            };
             // The midpoint of an untrusted step is the end of the step that follows.
             // Where the load cannot be evaluated (its callback failed), the step is
             // shortened, so that the transitions before that point are still reported; the
