@@ -292,6 +292,114 @@ fn far_window_ends_of_nonlinear_loads() {
     assert!(events >= 2000, "{events} events");
 }
 
+/// Nonlinear loads on a translated α axis: `f0 + φ(α − c) f1` over the case's window
+/// moved by c = 1e4, 1e6, 1e9 and −1e7 (as a basis and as a general load), on random
+/// problems and finite-element meshes. There α resolves a point only to ε |α| (1.2e-10
+/// at 1e6, against windows of length 2 to 8), more than the thresholds of its guards.
+/// Every event must be the affine path's (over [φ(α0), φ(α1)], untranslated) at
+/// c + φ⁻¹ of its α, to 1e-12 of the window plus 16 ulps of α. Before: a root one ulp
+/// away was halved forever (α near 1e6: the path never returned), and a touchdown's gap,
+/// moved onto its zero along the piece where α cannot resolve it, was read back from a
+/// cache at its old value (the node fitted no class). Run on a thread: a hang fails the
+/// test instead of stalling the suite.
+#[test]
+fn nonlinear_loads_on_a_translated_alpha_axis() {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let inv_phi = |p: f64| {
+            let mut a = p;
+            for _ in 0..60 {
+                a -= (phi(a) - p) / dphi(a);
+            }
+            a
+        };
+        let cases: Vec<common::Case> = (0..24u64)
+            .map(random_case)
+            .chain((0..4u64).map(|s| {
+                common::fe_case(s, 8 + 4 * s as usize, 2, [0.3, 1.5, 5.0, 0.8][s as usize])
+            }))
+            .collect();
+        let (mut worst_ulps, mut events) = (0.0f64, 0);
+        for shift in [1e4, 1e6, 1e9, -1e7] {
+            for case in &cases {
+                let (data, a0, a1) = (&case.data, case.a0, case.a1);
+                let affine = run(data, phi(a0), phi(a1));
+                for basis in [false, true] {
+                    let ctx = format!(
+                        "seed {} (p = {}), basis {basis}, α + {shift:e}",
+                        case.seed, data.p
+                    );
+                    let load = translated_load(data, basis, shift);
+                    let mut path = Path::new(
+                        Arc::new(data.problem()),
+                        load,
+                        fricont::PathOptions::window(a0 + shift, a1 + shift),
+                    )
+                    .unwrap();
+                    path.start(a0 + shift, None)
+                        .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
+                    path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
+                    let got = path.events();
+                    assert_eq!(got.len(), affine.events().len(), "{ctx}: events");
+                    for (k, (w, g)) in affine.events().iter().zip(got).enumerate() {
+                        let want = shift + inv_phi(w.alpha);
+                        let ulp = f64::EPSILON * want.abs();
+                        let err = (g.alpha - want).abs();
+                        worst_ulps = worst_ulps.max(err / ulp);
+                        assert!(
+                            (w.node, w.from, w.to) == (g.node, g.from, g.to)
+                                && err <= 1e-12 * (a1 - a0).abs() + 16.0 * ulp,
+                            "{ctx}: event {k}: α {} node {} {:?} → {:?}, the affine path's at α {want} node {} {:?} → {:?}",
+                            g.alpha,
+                            g.node + 1,
+                            g.from,
+                            g.to,
+                            w.node + 1,
+                            w.from,
+                            w.to
+                        );
+                    }
+                    events += got.len();
+                }
+            }
+        }
+        let _ = tx.send((events, worst_ulps));
+    });
+    let (events, worst) = rx
+        .recv_timeout(std::time::Duration::from_secs(600))
+        .expect("the traces finished (no hang) without a failure");
+    eprintln!("{events} events, worst {worst:.1} ulps of α");
+    assert!(events >= 1000, "{events} events");
+}
+
+/// `f0 + φ(α − c) f1` as a basis or a general load.
+fn translated_load(data: &Data, basis: bool, c: f64) -> fricont::Load {
+    let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
+    if basis {
+        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+            (w[0], w[1], dw[0], dw[1]) = (1.0, phi(a - c), 0.0, dphi(a - c));
+            Ok(())
+        };
+        return fricont::Load::basis(vec![f0, f1], Box::new(weights)).unwrap();
+    }
+    let df1 = f1.clone();
+    fricont::Load::general(
+        f0.len(),
+        Box::new(move |a: f64, out: &mut [f64]| {
+            for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+                *o = x + phi(a - c) * y;
+            }
+            Ok(())
+        }),
+        Some(Box::new(move |a: f64, out: &mut [f64]| {
+            for (o, y) in out.iter_mut().zip(&df1) {
+                *o = dphi(a - c) * y;
+            }
+            Ok(())
+        })),
+    )
+}
+
 #[test]
 fn global_force_and_stiffness_scalings() {
     for seed in 0..80 {

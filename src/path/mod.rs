@@ -607,9 +607,16 @@ impl<T: Clone> PointCache<T> {
         self.0.borrow_mut().clear();
     }
 
-    /// Keeps `v` for `(alpha, lam)`, dropping the oldest entry beyond [`Self::KEEP`].
+    /// Keeps `v` for `(alpha, lam)`, in place of an entry for the same point (a point
+    /// moved along its tangent by less than α's resolution keeps its α and λ, and only its
+    /// d moves: on an open piece at α ≈ 1e4 a touchdown's gap stayed at the root's
+    /// double's, 1.7 times its threshold, and the node fitted no class), dropping the
+    /// oldest entry beyond [`Self::KEEP`].
     fn put(&self, alpha: f64, lam: &[f64], v: T) {
         let mut cache = self.0.borrow_mut();
+        if let Some(k) = cache.iter().position(|(a, l, _)| *a == alpha && l == lam) {
+            cache.remove(k);
+        }
         if cache.len() == Self::KEEP {
             cache.remove(0);
         }
