@@ -158,9 +158,19 @@ fn dphi(a: f64) -> f64 {
     1.0 + 0.4 * (2.0 * a).cos()
 }
 
-/// `f0 + φ(α) f1` as a basis load (`basis`) or a general load, failing (the host's error)
-/// strictly beyond `fail = (α_f, direction)`: a path with a far window end stops there.
-fn nonlinear_load(data: &Data, basis: bool, fail: Option<(f64, f64)>) -> fricont::Load {
+/// φ⁻¹ by Newton's method (φ' ≥ 0.6).
+fn inv_phi(p: f64) -> f64 {
+    let mut a = p;
+    for _ in 0..60 {
+        a -= (phi(a) - p) / dphi(a);
+    }
+    a
+}
+
+/// `f0 + φ(α − c) f1` as a basis load (`basis`) or a general load, failing (the host's
+/// error) strictly beyond `fail = (α_f, direction)`: a path with a far window end stops
+/// there.
+fn nonlinear_load(data: &Data, basis: bool, c: f64, fail: Option<(f64, f64)>) -> fricont::Load {
     use fricont::load::LoadFailure;
     let beyond = move |a: f64| -> Result<(), LoadFailure> {
         match fail {
@@ -175,7 +185,7 @@ fn nonlinear_load(data: &Data, basis: bool, fail: Option<(f64, f64)>) -> fricont
     if basis {
         let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
             beyond(a)?;
-            (w[0], w[1], dw[0], dw[1]) = (1.0, phi(a), 0.0, dphi(a));
+            (w[0], w[1], dw[0], dw[1]) = (1.0, phi(a - c), 0.0, dphi(a - c));
             Ok(())
         };
         return fricont::Load::basis(vec![f0, f1], Box::new(weights)).unwrap();
@@ -186,13 +196,13 @@ fn nonlinear_load(data: &Data, basis: bool, fail: Option<(f64, f64)>) -> fricont
         Box::new(move |a: f64, out: &mut [f64]| {
             beyond(a)?;
             for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
-                *o = x + phi(a) * y;
+                *o = x + phi(a - c) * y;
             }
             Ok(())
         }),
         Some(Box::new(move |a: f64, out: &mut [f64]| {
             for (o, y) in out.iter_mut().zip(&df1) {
-                *o = dphi(a) * y;
+                *o = dphi(a - c) * y;
             }
             Ok(())
         })),
@@ -210,13 +220,6 @@ fn nonlinear_load(data: &Data, basis: bool, fail: Option<(f64, f64)>) -> fricont
 /// at zero) and the basis load stopped loudly (steps of length 1 past the step control).
 #[test]
 fn far_window_ends_of_nonlinear_loads() {
-    let inv_phi = |p: f64| {
-        let mut a = p;
-        for _ in 0..60 {
-            a -= (phi(a) - p) / dphi(a);
-        }
-        a
-    };
     let cases = (0..40u64).map(random_case).chain((0..8u64).map(|s| {
         common::fe_case(
             s,
@@ -245,7 +248,7 @@ fn far_window_ends_of_nonlinear_loads() {
                     None => (a1, None),
                     Some(f) => (a0 + dir * f, Some((a1 + 0.5 * (a1 - a0), dir))),
                 };
-                let load = nonlinear_load(data, basis, fail);
+                let load = nonlinear_load(data, basis, 0.0, fail);
                 let mut path = Path::new(
                     Arc::new(data.problem()),
                     load,
@@ -306,13 +309,6 @@ fn far_window_ends_of_nonlinear_loads() {
 fn nonlinear_loads_on_a_translated_alpha_axis() {
     let (tx, rx) = std::sync::mpsc::channel();
     std::thread::spawn(move || {
-        let inv_phi = |p: f64| {
-            let mut a = p;
-            for _ in 0..60 {
-                a -= (phi(a) - p) / dphi(a);
-            }
-            a
-        };
         let cases: Vec<common::Case> = (0..24u64)
             .map(random_case)
             .chain((0..4u64).map(|s| {
@@ -329,7 +325,7 @@ fn nonlinear_loads_on_a_translated_alpha_axis() {
                         "seed {} (p = {}), basis {basis}, α + {shift:e}",
                         case.seed, data.p
                     );
-                    let load = translated_load(data, basis, shift);
+                    let load = nonlinear_load(data, basis, shift, None);
                     let mut path = Path::new(
                         Arc::new(data.problem()),
                         load,
@@ -370,34 +366,6 @@ fn nonlinear_loads_on_a_translated_alpha_axis() {
         .expect("the traces finished (no hang) without a failure");
     eprintln!("{events} events, worst {worst:.1} ulps of α");
     assert!(events >= 1000, "{events} events");
-}
-
-/// `f0 + φ(α − c) f1` as a basis or a general load.
-fn translated_load(data: &Data, basis: bool, c: f64) -> fricont::Load {
-    let (f0, f1) = (data.f0.as_slice().to_vec(), data.f1.as_slice().to_vec());
-    if basis {
-        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
-            (w[0], w[1], dw[0], dw[1]) = (1.0, phi(a - c), 0.0, dphi(a - c));
-            Ok(())
-        };
-        return fricont::Load::basis(vec![f0, f1], Box::new(weights)).unwrap();
-    }
-    let df1 = f1.clone();
-    fricont::Load::general(
-        f0.len(),
-        Box::new(move |a: f64, out: &mut [f64]| {
-            for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
-                *o = x + phi(a - c) * y;
-            }
-            Ok(())
-        }),
-        Some(Box::new(move |a: f64, out: &mut [f64]| {
-            for (o, y) in out.iter_mut().zip(&df1) {
-                *o = dphi(a - c) * y;
-            }
-            Ok(())
-        })),
-    )
 }
 
 #[test]
