@@ -286,13 +286,42 @@ fn slender_strips_against_the_reference() {
 /// α = −2 every stage failed, its friction continuation at 0.875 F, and so on 1e-3 around
 /// it) is reached by the path from a nearby α. The start and the whole path must agree with
 /// the independent reference tracer (which checks that the start's piece reproduces its λ).
-/// Before the nearby starts, `Path::start` returned `SolveFailed` here.
+/// Before the nearby starts, `Path::start` returned `SolveFailed` here. With the window's
+/// far end at 1e12 the same start and events follow (the nearby α were 1e-3 … 1e-1 of the
+/// window's length away, 1e9 and more: every one failed, and so did the start).
 #[test]
 fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
     let mut case = common::fe_strip(3, 400, 4, 5.0, 10.0, 0.1);
     (case.a0, case.a1) = (-2.0, 2.0);
     let c = against_the_reference("seed 3, 400 × 4 elements on 10 × 0.1", &case);
     assert!(c.fricont.len() >= 100, "{} events", c.fricont.len());
+    let load = case.data.affine_load();
+    let mut path = fricont::Path::new(
+        Arc::new(case.data.problem()),
+        load,
+        fricont::PathOptions::window(-2.0, 1e12),
+    )
+    .unwrap();
+    path.start(-2.0, None).expect("start with a far window end");
+    while path.events().last().is_none_or(|e| e.alpha <= 2.0) {
+        if matches!(path.step().unwrap(), fricont::StepOutcome::End(_)) {
+            break;
+        }
+    }
+    let far = path.events();
+    assert!(far.len() >= c.fricont.len(), "{} events", far.len());
+    for (k, (&(a, i, from, to), e)) in c.fricont.iter().zip(far).enumerate() {
+        assert!(
+            (e.node, e.from, e.to) == (i, from, to)
+                && (e.alpha - a).abs() <= 1e-12 * a.abs().max(1.0),
+            "event {k}: α {} node {} {:?} → {:?}, with the window [−2, 2] α {a} node {} {from:?} → {to:?}",
+            e.alpha,
+            e.node + 1,
+            e.from,
+            e.to,
+            i + 1
+        );
+    }
 }
 
 /// `case` traced by fricont (default options) and by the independent tracer of

@@ -1521,8 +1521,9 @@ impl Path {
     /// along it that leads toward `alpha_end` (tried by stepping along each; events met on
     /// the way are the path's own).
     /// Where the fixed-α solver fails at `alpha`, it solves at a nearby α instead (1e-3,
-    /// 1e-2, 1e-1 of the window's length away, toward `alpha_end` first) and traces the
-    /// path from there back to `alpha`: its point there is the start.
+    /// 1e-2, 1e-1 of the window's length away, or of 1e3 times the load's own α scale
+    /// `‖q‖∞ / ‖q'‖∞` at `alpha` where that is shorter, toward `alpha_end` first) and
+    /// traces the path from there back to `alpha`: its point there is the start.
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails (also from every nearby α), the load fails, no piece leaves the start point
     /// toward `alpha_end`.
@@ -1537,7 +1538,9 @@ impl Path {
     /// strip (400 × 4 elements on 10 × 0.1, F = 5) every stage failed at α = −2 and on
     /// 1e-3 around it, while at α = −1.996 it converged and the path from there reached
     /// −2 on the same piece. Then the start is solved at α ± δ (δ = 1e-3, 1e-2, 1e-1 of the
-    /// window's length, toward `alpha_end` first, inside the window) and the path traced
+    /// window's length, or of the shorter [`Self::load_span`] at α: a window with a far
+    /// end, [−2, 1e12], probed 1e9 away and failed; toward `alpha_end` first, inside the
+    /// window) and the path traced
     /// from there to α (a window of its own; its events are dropped); the point it reaches
     /// is the start's guess, kept by the solver as it solves the problem. Where none leads
     /// to α: `SolveFailed` with the solver's message `failed` at α and what the nearby
@@ -1548,9 +1551,14 @@ impl Path {
         let toward = if opts.alpha_end >= alpha { 1.0 } else { -1.0 };
         let mut tried = Vec::new();
         let mut reached = None;
+        let m = 2 * self.problem.p();
+        let span = match self.point_at(vec![0.0; m], alpha) {
+            Ok(pt) => self.load_span(&pt),
+            Err(_) => hi - lo,
+        };
         'nearby: for frac in [1e-3, 1e-2, 1e-1] {
             for side in [toward, -toward] {
-                let a1 = (alpha + side * frac * (hi - lo)).clamp(lo, hi);
+                let a1 = (alpha + side * frac * span).clamp(lo, hi);
                 if a1 == alpha {
                     continue;
                 }
