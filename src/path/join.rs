@@ -76,7 +76,7 @@ impl Path {
             min_row: 2.0
                 * self.problem.default_r()
                 * DETERMINATION_BOUND
-                * inf_norm(&self.term_rows(pt)),
+                * inf_norm(&self.term_rows(pt).0),
             determined: DETERMINATION_BOUND,
             ..Widen::USUAL
         };

@@ -927,7 +927,7 @@ impl Path {
             return s;
         }
         let r0 = self.problem.default_r();
-        let terms = self.term_rows(pt).iter().fold(0.0f64, |a, &b| a.max(b));
+        let terms = self.term_rows(pt).0.iter().fold(0.0f64, |a, &b| a.max(b));
         let overlap =
             pt.q.iter()
                 .zip(self.problem.gap_equilibrated())
@@ -965,15 +965,21 @@ impl Path {
     /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
     /// ([`BoundLoad::term_magnitude_rows`]); for a general load, whose terms are not
     /// known, `|q_k| + L |q'_k|` (the change of q over an α length L: the window's, but
-    /// no more than a thousand times the point's own, see [`Self::load_span`]).
-    fn term_rows(&self, pt: &Point) -> Vec<f64> {
-        self.load.term_magnitude_rows(pt.alpha).unwrap_or_else(|| {
-            let span = self.load_span(pt);
-            pt.q.iter()
-                .zip(&pt.dq)
-                .map(|(q, dq)| q.abs() + span * dq.abs())
-                .collect()
-        })
+    /// no more than a thousand times the point's own, see [`Self::load_span`]). With
+    /// whether they are estimated so.
+    fn term_rows(&self, pt: &Point) -> (Vec<f64>, bool) {
+        match self.load.term_magnitude_rows(pt.alpha) {
+            Some(rows) => (rows, false),
+            None => {
+                let span = self.load_span(pt);
+                let rows =
+                    pt.q.iter()
+                        .zip(&pt.dq)
+                        .map(|(q, dq)| q.abs() + span * dq.abs())
+                        .collect();
+                (rows, true)
+            }
+        }
     }
 
     /// The "at zero" thresholds at a point. A row `d_k` of the displacement gaps is at
@@ -995,7 +1001,7 @@ impl Path {
         let z = self.opts.zero_tol;
         let r0 = self.problem.default_r();
         let m = pt.lam.len();
-        let qt = self.term_rows(pt);
+        let (qt, estimated) = self.term_rows(pt);
         let rows = TolRows {
             problem: self.problem.clone(),
             factor: z * r0,
@@ -1018,7 +1024,7 @@ impl Path {
             min_row: 0.0,
             determined: 0.0,
             cone: false,
-            estimated: self.load.term_magnitude_rows(pt.alpha).is_none(),
+            estimated,
         };
         self.tol_cache.put(pt.alpha, &pt.lam, tol.clone());
         tol
