@@ -942,9 +942,9 @@ impl Path {
 
     /// The α length that a nonlinear load's march (its first and its shortest steps) and a
     /// general load's estimated term magnitudes ([`Self::term_rows`]) are relative to at
-    /// `pt`: the window's length, but at most [`FAR_WINDOW`] times the
-    /// point's own α length, `max(|α − α_start|, ‖q‖∞ / ‖q'‖∞)` (how far the path has come,
-    /// and how far α moves the load by its own size; the window's length where both are 0).
+    /// `pt`: the window's length, but at most [`FAR_WINDOW`] times the point's own α
+    /// length, `max(|α − α_start|, ‖q‖∞ / ‖q'‖∞)` (how far the path has come, and how far
+    /// α moves the load by its own size; the window's length where both are 0).
     /// A far window end does not make the thresholds of a general load, or the least step
     /// of a march, a fixed fraction of the window: with the window's length itself, a
     /// window [a, 1e12] around a load varying on a scale of 1 made every guard "at zero"
@@ -1546,9 +1546,9 @@ impl Path {
     /// −2 on the same piece. Then the start is solved at α ± δ (δ = 1e-3, 1e-2, 1e-1 of the
     /// window's length, or of the shorter [`Self::load_span`] at α: a window with a far
     /// end, [−2, 1e12], probed 1e9 away and failed; toward `alpha_end` first, inside the
-    /// window) and the path traced
-    /// from there to α (a window of its own; its events are dropped); the point it reaches
-    /// is the start's guess, kept by the solver as it solves the problem. Where none leads
+    /// window) and the path traced from there to α (a window of its own; its events are
+    /// dropped); the point it reaches is the start's guess, kept by the solver as it
+    /// solves the problem. Where none leads
     /// to α: `SolveFailed` with the solver's message `failed` at α and what the nearby
     /// starts reached.
     fn start_from_nearby(&mut self, alpha: f64, failed: String) -> Result<()> {
