@@ -627,7 +627,15 @@ impl BoundLoad {
                     .anchor
                     .as_ref()
                     .map(|(fa, _)| fv.iter().zip(fa).map(|(a, b)| a - b).collect());
-                let mut qs = del.condense_many(&[change.as_deref().unwrap_or(&fv), &d])?;
+                // (a load near the largest double overflows in the solves: say so)
+                let big = inf_norm(&fv).max(inf_norm(&d));
+                let hint = |e: Error| match e {
+                    Error::Numerical(m) => Error::Numerical(m + &crate::path::overflow_hint(big)),
+                    e => e,
+                };
+                let mut qs = del
+                    .condense_many(&[change.as_deref().unwrap_or(&fv), &d])
+                    .map_err(hint)?;
                 let dq = qs.pop().expect("two columns");
                 let mut q = qs.pop().expect("two columns");
                 if let Some((_, qa)) = &self.anchor {
@@ -637,7 +645,10 @@ impl BoundLoad {
                 }
                 // Where W was refined, q's low part too: the tracer refines its points
                 // under this load on q + q_lo.
-                let q_lo = del.condense_lo(&[&fv], &[&q])?.and_then(|mut v| v.pop());
+                let q_lo = del
+                    .condense_lo(&[&fv], &[&q])
+                    .map_err(hint)?
+                    .and_then(|mut v| v.pop());
                 self.last_general = Some(GeneralEval {
                     alpha,
                     f: fv,

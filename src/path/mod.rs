@@ -804,12 +804,17 @@ fn classes_hash(classes: &[Class]) -> u64 {
 
 /// Numbers beyond 2^1000 ≈ 1.07e301 lie within a few orders of the largest double, where
 /// sums and products of the tracer's quantities can overflow.
-const NEAR_OVERFLOW: f64 = f64::from_bits((1023 + 1000) << 52);
+pub(crate) const NEAR_OVERFLOW: f64 = f64::from_bits((1023 + 1000) << 52);
 
 /// A hint for a failure at a point whose forces or loads exceed [`NEAR_OVERFLOW`], where
 /// the tracer's products can overflow; empty elsewhere.
 fn near_overflow(pt: &Point) -> String {
-    let big = inf_norm(&pt.lam).max(inf_norm(&pt.q)).max(inf_norm(&pt.dq));
+    overflow_hint(inf_norm(&pt.lam).max(inf_norm(&pt.q)).max(inf_norm(&pt.dq)))
+}
+
+/// The hint of [`near_overflow`] for numbers of magnitude `big` (forces or loads); empty
+/// where `big` is at most [`NEAR_OVERFLOW`].
+pub(crate) fn overflow_hint(big: f64) -> String {
     if big > NEAR_OVERFLOW {
         format!(
             "; the forces and loads there reach {big:e}, near the largest double, where \
