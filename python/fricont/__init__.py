@@ -452,6 +452,12 @@ class Problem:
         General load: ``load(alpha)`` returns f (length n), ``dload(alpha)`` its derivative
         (central differences when None); ``n`` defaults to the problem's n. Each evaluation
         costs a solve with the Cholesky factor of A.
+        Its accuracy: fricont does not see the terms that make up f, so where the load
+        passes through (near) zero it takes them as large as the load's change since the
+        path's start (at most over the window): where the load at a transition is far
+        smaller than that (``1e-8 * f0 + phi(alpha) * f1`` traced from phi = -1), nearby
+        transitions can be merged or moved without an error. A basis load has exact terms:
+        give the load so where it is a sum of fixed vectors.
         Basis load: ``f(alpha) = sum_j phi_j(alpha) basis[j]``, ``basis`` k vectors of
         length n, ``weights(alpha)`` returns ``(phi, dphi)``, the k weights and their
         derivatives. Each vector is condensed once, so an evaluation costs O(k p) instead
