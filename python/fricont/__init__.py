@@ -454,10 +454,10 @@ class Problem:
         costs a solve with the Cholesky factor of A.
         Its accuracy: fricont does not see the terms that make up f, so where the load
         passes through (near) zero it takes them as large as the load's change since the
-        path's start (at most over the window): where the load at a transition is far
-        smaller than that (``1e-8 * f0 + phi(alpha) * f1`` traced from phi = -1), nearby
-        transitions can be merged or moved without an error. A basis load has exact terms:
-        give the load so where it is a sum of fixed vectors.
+        last transition point (or the start; at most over the window): where the load at a
+        transition is far smaller than that (``1e-8 * f0 + phi(alpha) * f1`` just after a
+        start at alpha = 1), nearby transitions can be merged or moved without an error. A
+        basis load has exact terms: give the load so where it is a sum of fixed vectors.
         Basis load: ``f(alpha) = sum_j phi_j(alpha) basis[j]``, ``basis`` k vectors of
         length n, ``weights(alpha)`` returns ``(phi, dphi)``, the k weights and their
         derivatives. Each vector is condensed once, so an evaluation costs O(k p) instead

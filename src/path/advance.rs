@@ -812,7 +812,7 @@ impl Path {
             Ok((pt, table))
         };
         let (mut pa, mut ga) = eval(self, cur.alpha, false)?;
-        let span = self.load_span(&pa, FAR_WINDOW);
+        let span = self.load_span(&pa, FAR_WINDOW, self.opts.alpha_start);
         // The start of the step before `pa` and its guards (None on the first step).
         let mut behind: Option<(f64, Vec<GuardRow>)> = None;
         // (the default largest step is 1/8 of the window itself, as documented: a step
