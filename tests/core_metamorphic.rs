@@ -209,6 +209,19 @@ fn nonlinear_load(data: &Data, basis: bool, c: f64, fail: Option<(f64, f64)>) ->
     )
 }
 
+/// A path over `data` under `load` on the window [a0, end], started at a0.
+fn started(ctx: &str, data: &Data, load: fricont::Load, a0: f64, end: f64) -> Path {
+    let mut path = Path::new(
+        Arc::new(data.problem()),
+        load,
+        fricont::PathOptions::window(a0, end),
+    )
+    .unwrap();
+    path.start(a0, None)
+        .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
+    path
+}
+
 /// The first events of `got` are `want` (the affine path's events mapped through φ⁻¹:
 /// α and node change): the same node changes, and `err(α wanted, α got) ≤ tol`. Returns
 /// the largest `err`.
@@ -279,14 +292,7 @@ fn far_window_ends_of_nonlinear_loads() {
                     Some(f) => (a0 + dir * f, Some((a1 + 0.5 * (a1 - a0), dir))),
                 };
                 let load = nonlinear_load(data, basis, 0.0, fail);
-                let mut path = Path::new(
-                    Arc::new(data.problem()),
-                    load,
-                    fricont::PathOptions::window(a0, end),
-                )
-                .unwrap();
-                path.start(a0, None)
-                    .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
+                let mut path = started(&ctx, data, load, a0, end);
                 loop {
                     match path.step() {
                         Ok(fricont::StepOutcome::End(_)) => break,
@@ -343,14 +349,7 @@ fn nonlinear_loads_on_a_translated_alpha_axis() {
                         case.seed, data.p
                     );
                     let load = nonlinear_load(data, basis, shift, None);
-                    let mut path = Path::new(
-                        Arc::new(data.problem()),
-                        load,
-                        fricont::PathOptions::window(a0 + shift, a1 + shift),
-                    )
-                    .unwrap();
-                    path.start(a0 + shift, None)
-                        .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
+                    let mut path = started(&ctx, data, load, a0 + shift, a1 + shift);
                     path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
                     let got = path.events();
                     assert_eq!(got.len(), affine.events().len(), "{ctx}: events");
@@ -1005,14 +1004,7 @@ fn general_loads_through_zero_on_far_windows() {
                 case.seed, data.p
             );
             let load = nonlinear_load(&data, false, 0.0, Some((5.0, 1.0)));
-            let mut path = Path::new(
-                Arc::new(data.problem()),
-                load,
-                fricont::PathOptions::window(a0, end),
-            )
-            .unwrap();
-            path.start(a0, None)
-                .unwrap_or_else(|e| panic!("{ctx}: start: {e}"));
+            let mut path = started(&ctx, &data, load, a0, end);
             while path.events().last().is_none_or(|e| e.alpha < stop) {
                 match path.step() {
                     Ok(fricont::StepOutcome::End(_)) => break,
