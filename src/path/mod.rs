@@ -805,7 +805,7 @@ fn classes_hash(classes: &[Class]) -> u64 {
 
 /// Numbers beyond 2^1000 ≈ 1.07e301 lie within a few orders of the largest double, where
 /// sums and products of the tracer's quantities can overflow.
-pub(crate) const NEAR_OVERFLOW: f64 = f64::from_bits((1023 + 1000) << 52);
+const NEAR_OVERFLOW: f64 = f64::from_bits((1023 + 1000) << 52);
 
 /// A hint for a failure at a point whose forces or loads exceed [`NEAR_OVERFLOW`], where
 /// the tracer's products can overflow; empty elsewhere.
