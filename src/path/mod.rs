@@ -1552,9 +1552,10 @@ impl Path {
     /// along it that leads toward `alpha_end` (tried by stepping along each; events met on
     /// the way are the path's own).
     /// Where the fixed-α solver fails at `alpha`, it solves at a nearby α instead (1e-3,
-    /// 1e-2, 1e-1 of the window's length away, or of 1e3 times the load's own α scale
-    /// `‖q‖∞ / ‖q'‖∞` at `alpha` where that is shorter, toward `alpha_end` first) and
-    /// traces the path from there back to `alpha`: its point there is the start.
+    /// 1e-2, 1e-1 of the window's length away, or of 1e3 times the load's own α scale at
+    /// `alpha`, `max(‖q‖∞ / ‖q'‖∞, |alpha − alpha_start|)`, where that is shorter, toward
+    /// `alpha_end` first) and traces the path from there back to `alpha`: its point there
+    /// is the start.
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails (also from every nearby α), the load fails, no piece leaves the start point
     /// toward `alpha_end`.
