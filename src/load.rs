@@ -641,9 +641,11 @@ impl BoundLoad {
                     .as_ref()
                     .map(|(fa, _)| fv.iter().zip(fa).map(|(a, b)| a - b).collect());
                 // (a load near the largest double overflows in the solves: say so)
-                let big = inf_norm(&fv).max(inf_norm(&d));
                 let hint = |e: Error| match e {
-                    Error::Numerical(m) => Error::Numerical(m + &crate::path::overflow_hint(big)),
+                    Error::Numerical(m) => {
+                        let big = inf_norm(&fv).max(inf_norm(&d));
+                        Error::Numerical(m + &crate::path::overflow_hint(big))
+                    }
                     e => e,
                 };
                 let mut qs = del
