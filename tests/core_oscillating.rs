@@ -57,12 +57,12 @@ enum Given {
 }
 
 /// Traces the one node under c0 + sin(ω α + φ), given as `given`, from a0 to a1 and
-/// returns the events.
+/// returns the events, or the error that ended the trace.
 fn trace_one_node(
     (c0, omega, phase): (f64, f64, f64),
     (a0, a1): (f64, f64),
     given: Given,
-) -> Vec<(f64, Class, Class)> {
+) -> Result<Vec<(f64, Class, Class)>, fricont::Error> {
     let a = CsrMatrix::from_dense(2, 2, &[1.0, 0.0, 0.0, 1.0]).unwrap();
     let n = CsrMatrix::from_dense(1, 2, &[1.0, 0.0]).unwrap();
     let t = CsrMatrix::from_dense(1, 2, &[0.0, 1.0]).unwrap();
@@ -99,11 +99,12 @@ fn trace_one_node(
     };
     let mut path = Path::new(problem, load, PathOptions::window(a0, a1)).unwrap();
     path.start(a0, None).unwrap();
-    assert_eq!(path.run().unwrap(), EndReason::Window);
-    path.events()
+    assert_eq!(path.run()?, EndReason::Window);
+    Ok(path
+        .events()
         .iter()
         .map(|e| (e.alpha, e.from, e.to))
-        .collect()
+        .collect())
 }
 
 /// Traces the one node (as [`trace_one_node`]) and checks its events against `want`: the
@@ -114,7 +115,7 @@ fn check_one_node(
     given: Given,
     want: &[(f64, Class, Class)],
 ) {
-    let got = trace_one_node((c0, omega, phase), (a0, a1), given);
+    let got = trace_one_node((c0, omega, phase), (a0, a1), given).unwrap();
     let case = format!("c0 {c0} ω {omega} φ {phase} window ({a0}, {a1}), {given:?}");
     assert_eq!(got.len(), want.len(), "{case}: events {got:?}");
     for (g, w) in got.iter().zip(want) {
@@ -136,7 +137,8 @@ fn one_node_sine_load_finds_every_transition() {
         (0.9, 20.0, 0.0),
         (-5.0, 5.0),
         Given::General { derivative: true },
-    );
+    )
+    .unwrap();
     assert_eq!(got.len(), want.len(), "events {got:?}");
     for (g, w) in got.iter().zip(&want) {
         assert!((g.0 - w.0).abs() <= 1e-10, "α {} expected {}", g.0, w.0);
@@ -174,6 +176,30 @@ fn one_node_sine_loads_at_many_phases_frequencies_and_directions() {
         }
     }
     assert!(cases >= 150, "only {cases} cases");
+}
+
+/// The same node far out on the α axis, under sin(20 α) on [1e6, 1e6 + 50]: the load's
+/// own evaluation is off by up to 2e-9 there (20 α = 2e7 is rounded to 3.7e-9, one ulp of
+/// α moves the load by 2.3e-9), far above the guards' thresholds (about 2e-12), so the
+/// transitions cannot be located from its values (a root ulps wide comes out as
+/// several). The trace stops with an error that names the cause, α's rounding, and the
+/// remedy (an α axis centred on the window), as a general load and as a basis load; the
+/// same load centred on the window traces (the tests above).
+#[test]
+fn a_sine_far_out_on_the_alpha_axis_stops_and_names_alphas_rounding() {
+    for given in [
+        Given::General { derivative: true },
+        Given::General { derivative: false },
+        Given::Basis,
+    ] {
+        match trace_one_node((0.9, 20.0, 0.0), (1e6, 1e6 + 50.0), given) {
+            Err(fricont::Error::Numerical(msg)) => assert!(
+                msg.contains("one rounding of alpha") && msg.contains("centred on the window"),
+                "{given:?}: {msg}"
+            ),
+            other => panic!("{given:?}: expected a numerical error, got {other:?}"),
+        }
+    }
 }
 
 /// Loads whose period divides the march's first step: the cases of a random scan (3000

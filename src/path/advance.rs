@@ -1099,8 +1099,25 @@ impl Path {
                         gb[k].value - ga[k].value - 0.5 * (ga[k].slope + gb[k].slope) * delta;
                     if drift.abs() > tol[k] {
                         let node = gb[k].guard.node + 1;
+                        // One rounding of α moves the guard by |slope| ε |α|: a load
+                        // computed from α (sin(ω α) at ω α = 2e7 is off by 2e-9) is no
+                        // more accurate than that, whatever the solves.
+                        let by_alpha = 0.5
+                            * (ga[k].slope.abs() + gb[k].slope.abs())
+                            * f64::EPSILON
+                            * pb.alpha.abs();
+                        let cause = if by_alpha > tol[k] {
+                            format!(
+                                "at |alpha| = {:e} one rounding of alpha moves this guard by {by_alpha:e}, more than its threshold, so a load (or its weights) computed from alpha is too inaccurate here, whatever the solves: write the load on an alpha axis centred on the window (alpha - alpha_start), or raise zero_tol",
+                                pb.alpha.abs()
+                            )
+                        } else if self.load.basis_vectors().is_some() {
+                            "the solves along this piece (cond · eps) or the load's weights are too inaccurate here: build the problem with extended precision, or raise zero_tol".to_string()
+                        } else {
+                            "the solves of this nonlinear load are too inaccurate here (cond · eps): give the load as affine or basis (carried in extended precision), or raise zero_tol".to_string()
+                        };
                         return Err(Error::Numerical(format!(
-                            "the load's solutions at alpha = {:e} and {:e} disagree by {:e} on a guard of node {node}, more than its zero threshold {:e}: the solves of this nonlinear load are too inaccurate here (cond · eps) to locate a transition; give the load as affine or basis (carried in extended precision), or raise zero_tol",
+                            "the load's solutions at alpha = {:e} and {:e} disagree by {:e} on a guard of node {node}, more than its zero threshold {:e}, so no transition can be located on them; {cause}",
                             pa.alpha,
                             pb.alpha,
                             drift.abs(),
