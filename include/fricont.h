@@ -1151,8 +1151,9 @@ fricont_status fricont_path_new_affine(struct fricont_problem *problem,
  * nothing but the callback. Along each piece the solution is solved for once per vector
  * (k + 1 solves with the piece matrix), and the many evaluations that locate the piece's
  * end combine those solutions (O(k p) each); a general load (`fricont_path_new_general`)
- * costs solves with A and with the piece matrix at every evaluation instead. Prefer this
- * form whenever the load is a combination of a few fixed vectors.
+ * costs a solve with the piece matrix at every evaluation instead (and solves with A
+ * until its evaluations have spanned its directions). Prefer this form whenever the load
+ * is a combination of a few fixed vectors.
  *
  * * `problem`: not NULL (see `fricont_path_new_affine`).
  * * `vectors`: the k vectors, each of n values, stored one after the other (column-major
@@ -1182,9 +1183,17 @@ fricont_status fricont_path_new_basis(struct fricont_problem *problem,
 
 /**
  * Creates a path with a general load `f(α)` computed by a callback, with an optional
- * derivative callback. Each evaluation costs one solve with the Cholesky factor of A.
- * Without a derivative, f'(α) is approximated by central differences (used only for step
- * control and orientation: transition points are located on the guards themselves).
+ * derivative callback. Without a derivative, f'(α) is approximated by central differences
+ * (used only for step control and orientation: transition points are located on the
+ * guards themselves).
+ *
+ * Cost: each evaluation calls `f` (and `df`, or `f` twice more for the differences),
+ * condenses f(α) and f'(α) to the contact rows, and solves with the current piece's
+ * matrix (O(p²)). A vector within 64 ε (2-norm, relative) of the span of those condensed
+ * before is condensed as their combination (O(k n)) instead of by a solve with A: a load
+ * `Σ_j φ_j(α) f_j` of a few fixed vectors costs a few solves with A in all; a load that
+ * spans more than 8 directions solves with A at every evaluation (the span holds up to 8
+ * vectors of n values). A basis load (`fricont_path_new_basis`) is cheaper still.
  *
  * Accuracy: fricont does not see the terms that make up f(α), so it cannot tell how far
  * rounding moves f where the load passes through (near) zero. It takes them as large as

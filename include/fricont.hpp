@@ -483,7 +483,8 @@ public:
 
     /// The basis load f(α) = Σ_j φ_j(α) f_j: `vectors` the k fixed vectors f_j (n values
     /// each, copied), `weights` their weights. Each vector is condensed once, so that an
-    /// evaluation costs O(k p) where a `general` load costs a solve with A: prefer it
+    /// evaluation costs O(k p) where a `general` load costs a solve with the piece matrix
+    /// (and with A, until its evaluations span the load's directions): prefer it
     /// whenever the load is a combination of fixed vectors. Throws for no vectors,
     /// vectors of different lengths, an empty `weights`, and the library's errors.
     static Path basis(Problem &problem, const std::vector<std::vector<double>> &vectors,

@@ -15,11 +15,13 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %          Or a function handle f(alpha) returning an n-vector, and a function handle
 %          df(alpha) for f'(alpha) or [] (then central differences are used). MATLAB
 %          evaluates them between library calls; an error they raise stops the trace
-%          and is reported by fricont_trace. Each evaluation costs a solve with A.
+%          and is reported by fricont_trace. Each evaluation costs a solve with the
+%          piece matrix, and one with A until the evaluations span the load's
+%          directions (at most 8; then a combination of those solves).
 %          Or a basis load f(alpha) = V * phi(alpha): V an n-by-k matrix of fixed
 %          vectors and weights(alpha) a function handle returning the k-by-2 matrix
 %          [phi dphi] (the weights and their derivatives). Each column of V is condensed
-%          once, so an evaluation costs O(k p) instead of a solve with A: prefer it
+%          once, so an evaluation costs O(k p) instead of a piece solve: prefer it
 %          whenever the load is a combination of fixed vectors (an oscillating amplitude,
 %          several load cases), e.g. V = [f0 f1], weights = @(a) [1 0; sin(a) cos(a)].
 %   F      friction coefficient, a scalar or a p-vector (>= 0).

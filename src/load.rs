@@ -20,7 +20,7 @@
 //! Either stops the path cleanly with [`crate::Error::Load`], keeping what was traced.
 
 use crate::condense::Delassus;
-use crate::dense::inf_norm;
+use crate::dense::{axpy, dot, inf_norm};
 use crate::error::{Error, Result};
 
 /// Why a load closure failed: the caller's own code (kept and reported) and a message.
@@ -129,6 +129,15 @@ impl Load {
     /// and 1e-10 f0 + φ(α) f1 wrong events on 5 of 160 traces. A basis load
     /// ([`Load::basis`]) has exact terms and traced all of them: give the load so where it
     /// is a sum of fixed vectors.
+    ///
+    /// Cost: each evaluation calls `f` (and `df`, or `f` at α ± h for central differences)
+    /// and condenses f(α) and f'(α) to the contact rows. A vector within 64 ε (2-norm,
+    /// relative) of the span of the vectors condensed before is condensed as their
+    /// combination, O(k n), instead of by a solve with A: a load `Σ_j φ_j(α) f_j` of a few
+    /// fixed vectors costs a few solves with A in all (a load that spans more than 8
+    /// directions solves at every evaluation; the span holds 8 vectors of n values).
+    /// Each evaluation also solves with the current piece's matrix, O(p²), where a basis
+    /// load combines per-piece solutions, O(k p).
     pub fn general(n: usize, f: VectorFn, df: Option<VectorFn>) -> Load {
         Load::General { n, f, df }
     }
@@ -197,6 +206,122 @@ pub(crate) struct BoundLoad {
     last_general: Option<GeneralEval>,
     /// A general load's anchor `(f(α_a), q(α_a))` ([`Self::anchor_at`]).
     anchor: Option<(Vec<f64>, Vec<f64>)>,
+    /// A general load's condensations so far, reused for the vectors in their span.
+    span: Span,
+}
+
+/// Most vectors of a [`Span`]: a general load `Σ_j φ_j(α) f_j` of up to this many fixed
+/// vectors is condensed by solves with A only for its first few evaluations.
+const SPAN_MAX: usize = 8;
+
+/// How far (2-norm, relative) a vector may lie off a [`Span`] and be condensed from it:
+/// a few roundings, as a user's `f0 + φ(α) f1` evaluated in double is off the span of f0
+/// and f1 by at most about 2 ε.
+const SPAN_TOL: f64 = 64.0 * f64::EPSILON;
+
+/// A general load's condensed vectors, reused: an orthonormal basis (2-norm) `e_j` of the
+/// vectors condensed so far and their images `B A⁻¹ e_j`. A vector `v` within
+/// [`SPAN_TOL`] of their span (after two passes of Gram–Schmidt) is condensed as `Σ_j
+/// (e_j · v) B A⁻¹ e_j`, O(k n) instead of a solve with A (which is most of a general
+/// load's cost on a large mesh): the condensation of `v` perturbed by at most
+/// `SPAN_TOL ‖v‖₂` (its own rounding, of the size of the user's in evaluating `f`),
+/// smooth in α where fresh solves differ by `κ(A) ε`. A vector off the span adds its
+/// direction (one solve, as before); past [`SPAN_MAX`] directions the span is given up
+/// and every evaluation solves. Off for condensed input (no solves to save), where W was
+/// refined (q's low parts need the solves) and for small n.
+struct Span {
+    on: bool,
+    basis: Vec<Vec<f64>>,
+    images: Vec<Vec<f64>>,
+}
+
+impl Span {
+    fn new(on: bool) -> Self {
+        Span {
+            on,
+            basis: Vec::new(),
+            images: Vec::new(),
+        }
+    }
+
+    /// `B A⁻¹ v` for each `(v, r)` of `vs` from the span, `r` the 2-norm that `v`'s
+    /// distance from the span is measured against (`None`: `‖v‖₂`; for the difference of
+    /// two evaluations, the larger of theirs, whose rounding it carries). New directions
+    /// are condensed in one solve. `Ok(None)` where the span is off or given up, or a
+    /// vector's norm is outside 1e-150 … 1e150 (the caller solves).
+    fn condense(
+        &mut self,
+        del: &Delassus,
+        vs: &[(&[f64], Option<f64>)],
+    ) -> Result<Option<Vec<Vec<f64>>>> {
+        if !self.on {
+            return Ok(None);
+        }
+        let k0 = self.basis.len();
+        let mut fresh: Vec<Vec<f64>> = Vec::new();
+        let mut coeffs: Vec<Vec<f64>> = Vec::with_capacity(vs.len());
+        for &(v, reference) in vs {
+            let nv = dot(v, v).sqrt();
+            if nv == 0.0 {
+                coeffs.push(Vec::new());
+                continue;
+            }
+            // (within this range no dot product below over- or underflows)
+            if !(nv > 1e-150 && nv < 1e150) {
+                return Ok(None);
+            }
+            let reference = reference.unwrap_or(nv).max(nv);
+            let mut r = v.to_vec();
+            let mut c = vec![0.0; k0 + fresh.len()];
+            // Gram–Schmidt, a second pass only for a vector off the span after the first
+            // (twice is enough for its new direction to be orthogonal to working accuracy)
+            let mut off = nv;
+            for _ in 0..2 {
+                for (j, e) in self.basis.iter().chain(&fresh).enumerate() {
+                    let cj = dot(e, &r);
+                    axpy(&mut r, -cj, e);
+                    c[j] += cj;
+                }
+                off = dot(&r, &r).sqrt();
+                if off <= SPAN_TOL * reference {
+                    break;
+                }
+            }
+            if off > SPAN_TOL * reference {
+                if k0 + fresh.len() == SPAN_MAX || !off.is_normal() {
+                    self.on = false;
+                    self.basis.clear();
+                    self.images.clear();
+                    return Ok(None);
+                }
+                r.iter_mut().for_each(|x| *x /= off);
+                fresh.push(r);
+                c.push(off);
+            }
+            coeffs.push(c);
+        }
+        if !fresh.is_empty() {
+            let cols: Vec<&[f64]> = fresh.iter().map(|e| e.as_slice()).collect();
+            let images = del.condense_many(&cols)?;
+            self.basis.append(&mut fresh);
+            self.images.extend(images);
+        }
+        let m = del.w().nrows();
+        let out: Vec<Vec<f64>> = coeffs
+            .iter()
+            .map(|c| {
+                let mut q = vec![0.0; m];
+                for (cj, img) in c.iter().zip(&self.images) {
+                    axpy(&mut q, *cj, img);
+                }
+                q
+            })
+            .collect();
+        Ok(out
+            .iter()
+            .all(|q| q.iter().all(|x| x.is_finite()))
+            .then_some(out))
+    }
 }
 
 /// A general load evaluated at `alpha`: `q(α)`, `q'(α)` and, where W was refined, the
@@ -266,6 +391,12 @@ impl BoundLoad {
         if let Some(lo) = &q_lo {
             let _ = errors.set(Some(lo.iter().map(|l| inf_norm(l)).collect()));
         }
+        let span = Span::new(
+            matches!(load, Load::General { .. })
+                && !del.is_condensed()
+                && del.w_lo().is_none()
+                && del.load_len() > 4 * SPAN_MAX,
+        );
         let mut q_basis = q_basis;
         if let Some(lo) = &mut q_lo {
             for (q, l) in q_basis.iter_mut().zip(lo.iter_mut()) {
@@ -286,6 +417,7 @@ impl BoundLoad {
             recent_weights: Vec::new(),
             last_general: None,
             anchor: None,
+            span,
         })
     }
 
@@ -616,11 +748,15 @@ impl BoundLoad {
                 let n = *n;
                 let mut fv = vec![0.0; n];
                 call_vector(f, alpha, &mut fv, "f")?;
-                let d = match df {
+                let norm2 = |v: &[f64]| dot(v, v).sqrt();
+                // f'(α) given, or the central difference f(α + h) − f(α − h), divided by
+                // 2h (once condensed, where condensed from the span); with the 2-norm
+                // that a difference's rounding is measured against (see Span::condense)
+                let (dv, d_ref, d_div) = match df {
                     Some(df) => {
                         let mut d = vec![0.0; n];
                         call_vector(df, alpha, &mut d, "f'")?;
-                        d
+                        (d, None, 1.0)
                     }
                     None => {
                         let h = f64::EPSILON.cbrt() * alpha.abs().max(1.0);
@@ -628,31 +764,48 @@ impl BoundLoad {
                         let mut fm = vec![0.0; n];
                         call_vector(f, alpha + h, &mut fp, "f")?;
                         call_vector(f, alpha - h, &mut fm, "f")?;
-                        fp.iter()
-                            .zip(&fm)
-                            .map(|(a, b)| (a - b) / (2.0 * h))
-                            .collect()
+                        let reference = norm2(&fp).max(norm2(&fm));
+                        let dv = fp.iter().zip(&fm).map(|(a, b)| a - b).collect();
+                        (dv, Some(reference), 2.0 * h)
                     }
                 };
-                // q and q' in one pass over the factor of A (with an anchor, q as
-                // q(α_a) plus the condensed change of f).
+                // (with an anchor, q as q(α_a) plus the condensed change of f, whose
+                // rounding is that of the two evaluations)
                 let change: Option<Vec<f64>> = self
                     .anchor
                     .as_ref()
                     .map(|(fa, _)| fv.iter().zip(fa).map(|(a, b)| a - b).collect());
+                let base: &[f64] = change.as_deref().unwrap_or(&fv);
+                let base_ref = self
+                    .anchor
+                    .as_ref()
+                    .map(|(fa, _)| norm2(&fv).max(norm2(fa)));
                 // (a load near the largest double overflows in the solves: say so)
                 let hint = |e: Error| match e {
                     Error::Numerical(m) => {
-                        let big = inf_norm(&fv).max(inf_norm(&d));
+                        let big = inf_norm(&fv).max(inf_norm(&dv) / d_div);
                         Error::Numerical(m + &crate::path::overflow_hint(big))
                     }
                     e => e,
                 };
-                let mut qs = del
-                    .condense_many(&[change.as_deref().unwrap_or(&fv), &d])
+                let spanned = self
+                    .span
+                    .condense(del, &[(base, base_ref), (&dv, d_ref)])
                     .map_err(hint)?;
-                let dq = qs.pop().expect("two columns");
-                let mut q = qs.pop().expect("two columns");
+                let (mut q, dq) = match spanned {
+                    Some(mut qs) => {
+                        let mut dq = qs.pop().expect("two columns");
+                        dq.iter_mut().for_each(|x| *x /= d_div);
+                        (qs.pop().expect("two columns"), dq)
+                    }
+                    // q and q' in one pass over the factor of A
+                    None => {
+                        let d: Vec<f64> = dv.iter().map(|x| x / d_div).collect();
+                        let mut qs = del.condense_many(&[base, &d]).map_err(hint)?;
+                        let dq = qs.pop().expect("two columns");
+                        (qs.pop().expect("two columns"), dq)
+                    }
+                };
                 if let Some((_, qa)) = &self.anchor {
                     for (a, b) in q.iter_mut().zip(qa) {
                         *a += b;

@@ -410,3 +410,138 @@ fn failing_or_wrong_host_solves_are_errors() {
         "{e:?}"
     );
 }
+
+/// The load vector of [`general_loads_condense_by_solves_only_the_directions_they_span`]:
+/// `f0 + φ(α) f1` with φ(α) = α + 0.2 sin 2α (in the span of f0 and f1), plus, when
+/// `spread`, `0.05 ‖f1‖∞ sin(ω_i α + θ_i)` in every entry i with its own ω_i and θ_i
+/// (in the span of no few vectors).
+fn general_force(data: &Data, spread: bool, alpha: f64, out: &mut [f64]) {
+    let phi = alpha + 0.2 * (2.0 * alpha).sin();
+    let amp = 0.05 * inf(data.f1.as_slice());
+    for (i, o) in out.iter_mut().enumerate() {
+        *o = data.f0[i] + phi * data.f1[i];
+        if spread {
+            let (om, th) = (1.0 + 0.37 * i as f64, 0.91 * i as f64);
+            *o += amp * (om * alpha + th).sin();
+        }
+    }
+}
+
+/// A general load is condensed by solves with A only for the directions its evaluations
+/// span: on finite-element meshes (n from 72 to 198) under `f0 + φ(α) f1` as a general
+/// load, a host's solve is asked for at most 8 columns over the whole trace (the span's
+/// limit) against hundreds of evaluations of f, and the events are those of the same
+/// load condensed here by nalgebra at every α and given to [`ProblemBuilder::condensed`]
+/// (no solves to save there: every α its own condensation). With a term in every entry
+/// that no few vectors span, the span is given up after 8 directions and every
+/// evaluation solves: the same events as the condensed reference again. Events: α to
+/// 1e-10 relative, nodes, classes, flags; λ to 1e-9 of the path's force scale.
+#[test]
+fn general_loads_condense_by_solves_only_the_directions_they_span() {
+    let mut events = 0;
+    for seed in 0..12u64 {
+        let nx = 8 + (seed % 5) as usize;
+        let ny = 2 + (seed % 2) as usize;
+        let friction = [0.3, 1.0, 5.0][(seed % 3) as usize];
+        let case = fe_case(seed, nx, ny, friction);
+        let data = Arc::new(case.data.clone());
+        assert!(
+            data.n > 32,
+            "seed {seed}: n = {} (the span is off below 33)",
+            data.n
+        );
+        for spread in [false, true] {
+            let ctx = format!("FE seed {seed} ({nx}x{ny}, F = {friction}, spread {spread})");
+            // the reference: q(α) = B A⁻¹ f(α) by nalgebra, on condensed input
+            let (b, w) = Brute::condensed(&data);
+            let chol = data.a.clone().cholesky().expect("A SPD");
+            let reference = {
+                let problem = ProblemBuilder::condensed(to_faer(&w))
+                    .friction(data.friction.clone())
+                    .gap(data.gap.clone())
+                    .build()
+                    .expect("condensed problem");
+                let d = data.clone();
+                let q = Box::new(move |al: f64, out: &mut [f64]| {
+                    let mut f = DVector::zeros(d.n);
+                    general_force(&d, spread, al, f.as_mut_slice());
+                    out.copy_from_slice((&b * chol.solve(&f)).as_slice());
+                    Ok(())
+                });
+                run(problem, Load::general(w.nrows(), q, None), case.a0, case.a1)
+            };
+            // fricont's condensation through a host's solve, counting its columns
+            let columns = Arc::new(AtomicUsize::new(0));
+            let calls = Arc::new(AtomicUsize::new(0));
+            let problem = ProblemBuilder::with_solve(
+                data.n,
+                nalgebra_solve(&data.a, 3, columns.clone()),
+                csr(&data.nm),
+                csr(&data.tm),
+            )
+            .friction(data.friction.clone())
+            .gap(data.gap.clone())
+            .build()
+            .expect("problem with a host's solve");
+            let (d, c) = (data.clone(), calls.clone());
+            let f = Box::new(move |al: f64, out: &mut [f64]| {
+                c.fetch_add(1, Ordering::Relaxed);
+                general_force(&d, spread, al, out);
+                Ok(())
+            });
+            let before = columns.load(Ordering::Relaxed);
+            let hosted = run(problem, Load::general(data.n, f, None), case.a0, case.a1);
+            let (solved, evaluated) = (
+                columns.load(Ordering::Relaxed) - before,
+                calls.load(Ordering::Relaxed),
+            );
+            if spread {
+                assert!(solved > 8, "{ctx}: {solved} columns solved");
+            } else {
+                assert!(
+                    solved <= 8 && evaluated >= 100,
+                    "{ctx}: {solved} columns solved for {evaluated} evaluations of f"
+                );
+            }
+            let (er, eo) = (reference.events(), hosted.events());
+            assert_eq!(er.len(), eo.len(), "{ctx}: number of events");
+            let scale = reference.pieces().iter().fold(1e-300f64, |m, pc| {
+                m.max(inf(&pc.lambda_from)).max(inf(&pc.lambda_to))
+            });
+            for (x, y) in er.iter().zip(eo) {
+                assert!(
+                    (x.alpha - y.alpha).abs() <= 1e-10 * x.alpha.abs().max(1.0),
+                    "{ctx}: event {} at α {:.17e} (condensed) vs {:.17e}",
+                    x.index + 1,
+                    x.alpha,
+                    y.alpha
+                );
+                assert_eq!(
+                    (x.node, x.from, x.to, x.fold, x.bifurcation),
+                    (y.node, y.from, y.to, y.fold, y.bifurcation),
+                    "{ctx}: event {}",
+                    x.index + 1
+                );
+                for (a, b) in x
+                    .lambda_n
+                    .iter()
+                    .chain(&x.lambda_t)
+                    .zip(y.lambda_n.iter().chain(&y.lambda_t))
+                {
+                    assert!(
+                        (a - b).abs() <= 1e-9 * scale,
+                        "{ctx}: event {}: λ {a:e} vs {b:e}",
+                        x.index + 1
+                    );
+                }
+            }
+            assert_eq!(reference.end_reason(), hosted.end_reason(), "{ctx}: end");
+            events += er.len();
+            eprintln!(
+                "{ctx}: {} events, {solved} columns for {evaluated} evaluations",
+                er.len()
+            );
+        }
+    }
+    assert!(events > 100, "only {events} events compared");
+}

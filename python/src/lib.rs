@@ -270,7 +270,7 @@ impl Problem {
 
     /// Traces a basis load `f(α) = Σ_j φ_j(α) f_j`: `vectors` the f_j (n values each),
     /// `weights(alpha)` returns `(phi, dphi)`, the k weights and their derivatives. Each
-    /// vector is condensed once, so an evaluation costs O(k p), not a solve with A. An
+    /// vector is condensed once, so an evaluation costs O(k p), not a piece solve. An
     /// exception inside `weights` stops the path; it is kept on the path and re-raised by
     /// the Python layer.
     #[allow(clippy::too_many_arguments)]
