@@ -261,20 +261,41 @@ impl Span {
         let mut fresh: Vec<Vec<f64>> = Vec::new();
         let mut coeffs: Vec<Vec<f64>> = Vec::with_capacity(vs.len());
         for &(v, reference) in vs {
-            let nv = dot(v, v).sqrt();
+            // One pass for every e_j · v and v · v, one for the distance from the span
+            // (classical Gram–Schmidt, its rounding k ε ‖v‖₂ below SPAN_TOL's): a vector in
+            // the span is neither copied nor written.
+            let (c, vv) = Fused {
+                es: &self.basis,
+                more: &fresh,
+                v,
+                c: None,
+            }
+            .run();
+            let nv = vv.sqrt();
             if nv == 0.0 {
                 coeffs.push(Vec::new());
                 continue;
             }
-            // (within this range no dot product below over- or underflows)
+            // (within this range no dot product over- or underflows)
             if !(nv > 1e-150 && nv < 1e150) {
                 return Ok(None);
             }
             let reference = reference.unwrap_or(nv).max(nv);
+            let (_, rr) = Fused {
+                es: &self.basis,
+                more: &fresh,
+                v,
+                c: Some(&c),
+            }
+            .run();
+            if rr.sqrt() <= SPAN_TOL * reference {
+                coeffs.push(c);
+                continue;
+            }
+            // Off the span (or nearly): modified Gram–Schmidt on a copy, twice, for an
+            // orthogonal new direction.
             let mut r = v.to_vec();
             let mut c = vec![0.0; k0 + fresh.len()];
-            // Gram–Schmidt, a second pass only for a vector off the span after the first
-            // (twice is enough for its new direction to be orthogonal to working accuracy)
             let mut off = nv;
             for _ in 0..2 {
                 for (j, e) in self.basis.iter().chain(&fresh).enumerate() {
@@ -321,6 +342,89 @@ impl Span {
             .iter()
             .all(|q| q.iter().all(|x| x.is_finite()))
             .then_some(out))
+    }
+}
+
+/// One pass over `v` and the vectors `es`, then `more` (at most [`SPAN_MAX`] in all):
+/// without `c`, `((e_j · v)_j, v · v)`; with `c`, `((), ‖v − Σ_j c_j e_j‖₂²)`, the
+/// residual formed entry by entry and not stored. In eight lanes, compiled for the
+/// machine's vector instructions by faer's dispatch (as [`crate::dense::dot`]).
+struct Fused<'a> {
+    es: &'a [Vec<f64>],
+    more: &'a [Vec<f64>],
+    v: &'a [f64],
+    c: Option<&'a [f64]>,
+}
+
+impl Fused<'_> {
+    fn run(self) -> (Vec<f64>, f64) {
+        faer::traits::pulp::Arch::new().dispatch(self)
+    }
+}
+
+impl faer::traits::pulp::WithSimd for Fused<'_> {
+    type Output = (Vec<f64>, f64);
+    #[inline(always)]
+    fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) -> (Vec<f64>, f64) {
+        const L: usize = 8;
+        let es: Vec<&[f64]> = self.es.iter().chain(self.more).map(|e| &e[..]).collect();
+        let k = es.len().min(SPAN_MAX);
+        let n = self.v.len();
+        let body = n - n % L;
+        let mut acc = [[0.0f64; L]; SPAN_MAX + 1];
+        let fold = |a: &[f64; L]| ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]));
+        match self.c {
+            None => {
+                for i in (0..body).step_by(L) {
+                    let v: &[f64; L] = self.v[i..i + L].try_into().expect("a lane");
+                    for l in 0..L {
+                        acc[SPAN_MAX][l] = v[l].mul_add(v[l], acc[SPAN_MAX][l]);
+                    }
+                    for (a, e) in acc.iter_mut().zip(&es[..k]) {
+                        let e: &[f64; L] = e[i..i + L].try_into().expect("a lane");
+                        for l in 0..L {
+                            a[l] = e[l].mul_add(v[l], a[l]);
+                        }
+                    }
+                }
+                let mut out: Vec<f64> = acc[..k].iter().map(fold).collect();
+                let mut vv = fold(&acc[SPAN_MAX]);
+                for i in body..n {
+                    vv += self.v[i] * self.v[i];
+                    for (o, e) in out.iter_mut().zip(&es[..k]) {
+                        *o += e[i] * self.v[i];
+                    }
+                }
+                (out, vv)
+            }
+            Some(c) => {
+                let k = k.min(c.len());
+                let at = |i: usize| {
+                    let mut r = self.v[i];
+                    for (cj, e) in c[..k].iter().zip(&es[..k]) {
+                        r = (-cj).mul_add(e[i], r);
+                    }
+                    r
+                };
+                for i in (0..body).step_by(L) {
+                    let mut r: [f64; L] = self.v[i..i + L].try_into().expect("a lane");
+                    for (cj, e) in c[..k].iter().zip(&es[..k]) {
+                        let e: &[f64; L] = e[i..i + L].try_into().expect("a lane");
+                        for l in 0..L {
+                            r[l] = (-cj).mul_add(e[l], r[l]);
+                        }
+                    }
+                    for l in 0..L {
+                        acc[0][l] = r[l].mul_add(r[l], acc[0][l]);
+                    }
+                }
+                let mut rr = fold(&acc[0]);
+                for i in body..n {
+                    rr += at(i) * at(i);
+                }
+                (Vec::new(), rr)
+            }
+        }
     }
 }
 
