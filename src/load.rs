@@ -133,11 +133,14 @@ impl Load {
     /// Cost: each evaluation calls `f` (and `df`, or `f` at α ± h for central differences)
     /// and condenses f(α) and f'(α) to the contact rows. A vector within 64 ε (2-norm,
     /// relative) of the span of the vectors condensed before is condensed as their
-    /// combination, O(k n), instead of by a solve with A: a load `Σ_j φ_j(α) f_j` of a few
-    /// fixed vectors costs a few solves with A in all (a load that spans more than 8
-    /// directions solves at every evaluation; the span holds 8 vectors of n values).
-    /// Each evaluation also solves with the current piece's matrix, O(p²), where a basis
-    /// load combines per-piece solutions, O(k p).
+    /// combination, O(k n), instead of by a solve with A (exactly, for the vector moved by
+    /// at most that much): a load `Σ_j φ_j(α) f_j` of a few fixed vectors costs a few
+    /// solves with A in all. A load that spans more than 8 directions solves at every
+    /// evaluation (the span holds up to 8 vectors of n values), and so does every load
+    /// where W was refined ([`crate::ProblemBuilder::extended_precision`]: `Auto` refines
+    /// small and ill-conditioned problems), on condensed input and for n ≤ 32. Each
+    /// evaluation also solves with the current piece's matrix, O(p²), where a basis load
+    /// combines per-piece solutions, O(k p).
     pub fn general(n: usize, f: VectorFn, df: Option<VectorFn>) -> Load {
         Load::General { n, f, df }
     }
@@ -221,14 +224,15 @@ const SPAN_TOL: f64 = 64.0 * f64::EPSILON;
 
 /// A general load's condensed vectors, reused: an orthonormal basis (2-norm) `e_j` of the
 /// vectors condensed so far and their images `B A⁻¹ e_j`. A vector `v` within
-/// [`SPAN_TOL`] of their span (after two passes of Gram–Schmidt) is condensed as `Σ_j
+/// [`SPAN_TOL`] of their span (one pass of classical Gram–Schmidt) is condensed as `Σ_j
 /// (e_j · v) B A⁻¹ e_j`, O(k n) instead of a solve with A (which is most of a general
-/// load's cost on a large mesh): the condensation of `v` perturbed by at most
-/// `SPAN_TOL ‖v‖₂` (its own rounding, of the size of the user's in evaluating `f`),
-/// smooth in α where fresh solves differ by `κ(A) ε`. A vector off the span adds its
-/// direction (one solve, as before); past [`SPAN_MAX`] directions the span is given up
-/// and every evaluation solves. Off for condensed input (no solves to save), where W was
-/// refined (q's low parts need the solves) and for small n.
+/// load's cost on a large mesh): the exact condensation of `v` perturbed by at most
+/// `SPAN_TOL ‖v‖₂` (a normwise backward error, of the size of the user's rounding in
+/// evaluating `f`), smooth in α where fresh solves differ by `κ(A) ε`. A vector off the
+/// span adds its direction (modified Gram–Schmidt twice, one solve); past [`SPAN_MAX`]
+/// directions the span is given up and every evaluation solves. Off for condensed input
+/// (no solves to save), where W was refined (q's low parts need the solves) and for n ≤
+/// 32.
 struct Span {
     on: bool,
     basis: Vec<Vec<f64>>,

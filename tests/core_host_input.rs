@@ -428,7 +428,7 @@ fn general_force(data: &Data, spread: bool, alpha: f64, out: &mut [f64]) {
 }
 
 /// A general load is condensed by solves with A only for the directions its evaluations
-/// span: on finite-element meshes (n from 72 to 198) under `f0 + φ(α) f1` as a general
+/// span: on finite-element meshes (n from 48 to 96) under `f0 + φ(α) f1` as a general
 /// load, a host's solve is asked for at most 8 columns over the whole trace (the span's
 /// limit) against hundreds of evaluations of f, and the events are those of the same
 /// load condensed here by nalgebra at every α and given to [`ProblemBuilder::condensed`]
