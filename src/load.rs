@@ -211,6 +211,25 @@ pub(crate) struct BoundLoad {
     anchor: Option<(Vec<f64>, Vec<f64>)>,
     /// A general load's condensations so far, reused for the vectors in their span.
     span: Span,
+    /// n-vectors of a general load's evaluations, reused: allocated afresh at each
+    /// evaluation, vectors of a large mesh's n were paged in (and zeroed by the kernel)
+    /// again and again.
+    pool: Vec<Vec<f64>>,
+}
+
+/// A zeroed vector of `n` values from `pool` (or a new one).
+fn take(pool: &mut Vec<Vec<f64>>, n: usize) -> Vec<f64> {
+    let mut v = pool.pop().unwrap_or_default();
+    v.clear();
+    v.resize(n, 0.0);
+    v
+}
+
+/// Returns `v` to `pool` (at most a few are kept).
+fn give(pool: &mut Vec<Vec<f64>>, v: Vec<f64>) {
+    if pool.len() < 6 {
+        pool.push(v);
+    }
 }
 
 /// Most vectors of a [`Span`]: a general load `Σ_j φ_j(α) f_j` of up to this many fixed
@@ -526,6 +545,7 @@ impl BoundLoad {
             last_general: None,
             anchor: None,
             span,
+            pool: Vec::new(),
         })
     }
 
@@ -854,7 +874,7 @@ impl BoundLoad {
                     return Ok((e.q.clone(), e.dq.clone()));
                 }
                 let n = *n;
-                let mut fv = vec![0.0; n];
+                let mut fv = take(&mut self.pool, n);
                 call_vector(f, alpha, &mut fv, "f")?;
                 let norm2 = |v: &[f64]| dot(v, v).sqrt();
                 // f'(α) given, or the central difference f(α + h) − f(α − h), divided by
@@ -862,27 +882,33 @@ impl BoundLoad {
                 // that a difference's rounding is measured against (see Span::condense)
                 let (dv, d_ref, d_div) = match df {
                     Some(df) => {
-                        let mut d = vec![0.0; n];
+                        let mut d = take(&mut self.pool, n);
                         call_vector(df, alpha, &mut d, "f'")?;
                         (d, None, 1.0)
                     }
                     None => {
                         let h = f64::EPSILON.cbrt() * alpha.abs().max(1.0);
-                        let mut fp = vec![0.0; n];
-                        let mut fm = vec![0.0; n];
+                        let mut fp = take(&mut self.pool, n);
+                        let mut fm = take(&mut self.pool, n);
                         call_vector(f, alpha + h, &mut fp, "f")?;
                         call_vector(f, alpha - h, &mut fm, "f")?;
                         let reference = norm2(&fp).max(norm2(&fm));
-                        let dv = fp.iter().zip(&fm).map(|(a, b)| a - b).collect();
-                        (dv, Some(reference), 2.0 * h)
+                        for (a, b) in fp.iter_mut().zip(&fm) {
+                            *a -= b;
+                        }
+                        give(&mut self.pool, fm);
+                        (fp, Some(reference), 2.0 * h)
                     }
                 };
                 // (with an anchor, q as q(α_a) plus the condensed change of f, whose
                 // rounding is that of the two evaluations)
-                let change: Option<Vec<f64>> = self
-                    .anchor
-                    .as_ref()
-                    .map(|(fa, _)| fv.iter().zip(fa).map(|(a, b)| a - b).collect());
+                let change: Option<Vec<f64>> = self.anchor.as_ref().map(|(fa, _)| {
+                    let mut c = take(&mut self.pool, n);
+                    for ((c, a), b) in c.iter_mut().zip(&fv).zip(fa) {
+                        *c = a - b;
+                    }
+                    c
+                });
                 let base: &[f64] = change.as_deref().unwrap_or(&fv);
                 let base_ref = self
                     .anchor
@@ -925,7 +951,11 @@ impl BoundLoad {
                     .condense_lo(&[&fv], &[&q])
                     .map_err(hint)?
                     .and_then(|mut v| v.pop());
-                self.last_general = Some(GeneralEval {
+                give(&mut self.pool, dv);
+                if let Some(c) = change {
+                    give(&mut self.pool, c);
+                }
+                let old = self.last_general.replace(GeneralEval {
                     alpha,
                     f: fv,
                     q: q.clone(),
@@ -933,6 +963,9 @@ impl BoundLoad {
                     q_lo,
                     error: std::cell::OnceCell::new(),
                 });
+                if let Some(old) = old {
+                    give(&mut self.pool, old.f);
+                }
                 Ok((q, dq))
             }
         }
