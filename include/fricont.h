@@ -1191,12 +1191,14 @@ fricont_status fricont_path_new_basis(struct fricont_problem *problem,
  * condenses f(α) and f'(α) to the contact rows, and solves with the current piece's
  * matrix (O(p²)). A vector within 64 ε (2-norm, relative) of the span of those condensed
  * before is condensed as their combination (O(k n)) instead of by a solve with A
- * (exactly, for the vector moved by at most that much): a load `Σ_j φ_j(α) f_j` of a few
- * fixed vectors costs a few solves with A in all. A load that spans more than 8
- * directions solves with A at every evaluation (the span holds up to 8 vectors of n
- * values), and so does every load where W was refined
- * (`fricont_problem_set_extended_precision`: auto refines small and ill-conditioned
- * problems) and for n ≤ 32. A basis load (`fricont_path_new_basis`) is cheaper still.
+ * (exactly, for the vector moved by at most that much; checked against a solve at the
+ * 1st, 2nd, 4th, … such evaluation, and given up where they differ by more than 1e-6): a
+ * load `Σ_j φ_j(α) f_j` of a few fixed vectors costs a few dozen solves with A in all
+ * instead of one per evaluation. A load that spans more than 8 directions solves with A
+ * at every evaluation (the span holds up to 8 vectors of n values), and so does every
+ * load where W was refined (`fricont_problem_set_extended_precision`: auto refines small
+ * and ill-conditioned problems) and for n ≤ 32. A basis load (`fricont_path_new_basis`)
+ * is cheaper still.
  *
  * Accuracy: fricont does not see the terms that make up f(α), so it cannot tell how far
  * rounding moves f where the load passes through (near) zero. It takes them as large as
