@@ -439,6 +439,27 @@ fn general_force(data: &Data, spread: bool, alpha: f64, out: &mut [f64]) {
     }
 }
 
+/// The reference for a general load [`general_force`] on `data`: q(α) = B A⁻¹ f(α) by
+/// nalgebra at every α, on condensed input (where fricont solves nothing), traced over
+/// (a0, a1).
+fn condensed_general_reference(data: &Arc<Data>, spread: bool, a0: f64, a1: f64) -> Path {
+    let (b, w) = Brute::condensed(data);
+    let chol = data.a.clone().cholesky().expect("A SPD");
+    let problem = ProblemBuilder::condensed(to_faer(&w))
+        .friction(data.friction.clone())
+        .gap(data.gap.clone())
+        .build()
+        .expect("condensed problem");
+    let d = data.clone();
+    let q = Box::new(move |al: f64, out: &mut [f64]| {
+        let mut f = DVector::zeros(d.n);
+        general_force(&d, spread, al, f.as_mut_slice());
+        out.copy_from_slice((&b * chol.solve(&f)).as_slice());
+        Ok(())
+    });
+    run(problem, Load::general(w.nrows(), q, None), a0, a1)
+}
+
 /// A general load is condensed by solves with A only for the directions its evaluations
 /// span: on finite-element meshes (n from 48 to 96) under `f0 + φ(α) f1` as a general
 /// load, a host's solve is asked for at most 8 columns over the whole trace for the span's
@@ -466,24 +487,7 @@ fn general_loads_condense_by_solves_only_the_directions_they_span() {
         );
         for spread in [false, true] {
             let ctx = format!("FE seed {seed} ({nx}x{ny}, F = {friction}, spread {spread})");
-            // the reference: q(α) = B A⁻¹ f(α) by nalgebra, on condensed input
-            let (b, w) = Brute::condensed(&data);
-            let chol = data.a.clone().cholesky().expect("A SPD");
-            let reference = {
-                let problem = ProblemBuilder::condensed(to_faer(&w))
-                    .friction(data.friction.clone())
-                    .gap(data.gap.clone())
-                    .build()
-                    .expect("condensed problem");
-                let d = data.clone();
-                let q = Box::new(move |al: f64, out: &mut [f64]| {
-                    let mut f = DVector::zeros(d.n);
-                    general_force(&d, spread, al, f.as_mut_slice());
-                    out.copy_from_slice((&b * chol.solve(&f)).as_slice());
-                    Ok(())
-                });
-                run(problem, Load::general(w.nrows(), q, None), case.a0, case.a1)
-            };
+            let reference = condensed_general_reference(&data, spread, case.a0, case.a1);
             // fricont's condensation through a host's solve, counting its columns
             let columns = Arc::new(AtomicUsize::new(0));
             let calls = Arc::new(AtomicUsize::new(0));
@@ -572,23 +576,7 @@ fn a_load_mostly_off_the_contact_gives_the_span_up() {
             Ok(())
         });
         let hosted = run(problem, Load::general(n, f, None), case.a0, case.a1);
-        let (b, w) = Brute::condensed(&data);
-        let chol = data.a.clone().cholesky().expect("A SPD");
-        let reference = {
-            let problem = ProblemBuilder::condensed(to_faer(&w))
-                .friction(data.friction.clone())
-                .gap(data.gap.clone())
-                .build()
-                .expect("condensed problem");
-            let d = data.clone();
-            let q = Box::new(move |al: f64, out: &mut [f64]| {
-                let mut f = DVector::zeros(d.n);
-                general_force(&d, false, al, f.as_mut_slice());
-                out.copy_from_slice((&b * chol.solve(&f)).as_slice());
-                Ok(())
-            });
-            run(problem, Load::general(w.nrows(), q, None), case.a0, case.a1)
-        };
+        let reference = condensed_general_reference(&data, false, case.a0, case.a1);
         let ctx = format!("FE seed {seed} with a decoupled dof loaded by {big:e}");
         let events = assert_same_path_within(&ctx, &reference, &hosted, 1e-10, 1e-9);
         assert!(events > 0, "{ctx}: no events");
