@@ -252,9 +252,8 @@ const SPAN_TOL: f64 = 64.0 * f64::EPSILON;
 /// evaluating `f`), smooth in α where fresh solves differ by `κ(A) ε`. A vector off the
 /// span adds its direction (modified Gram–Schmidt twice, one solve); past [`SPAN_MAX`]
 /// directions, or where a check against a solve ([`SPAN_CHECK_TOL`]) fails, the span is
-/// given up and every evaluation solves. Off for condensed input
-/// (no solves to save), where W was refined (q's low parts need the solves) and for n ≤
-/// 32.
+/// given up and every evaluation solves. Off for condensed input (no solves to save), where
+/// W was refined (q's low parts need the solves) and for n ≤ 32.
 struct Span {
     on: bool,
     basis: Vec<Vec<f64>>,
@@ -281,6 +280,13 @@ impl Span {
             images: Vec::new(),
             served: 0,
         }
+    }
+
+    /// Off for good: every evaluation solves (and the basis's memory is freed).
+    fn give_up(&mut self) {
+        self.on = false;
+        self.basis.clear();
+        self.images.clear();
     }
 
     /// `B A⁻¹ v` for each `(v, r)` of `vs` from the span, `r` the 2-norm that `v`'s
@@ -349,9 +355,7 @@ impl Span {
             }
             if off > SPAN_TOL * reference {
                 if k0 + fresh.len() == SPAN_MAX || !off.is_normal() {
-                    self.on = false;
-                    self.basis.clear();
-                    self.images.clear();
+                    self.give_up();
                     return Ok(None);
                 }
                 r.iter_mut().for_each(|x| *x /= off);
@@ -395,9 +399,7 @@ impl Span {
                     diff <= SPAN_CHECK_TOL * scale
                 });
                 if !agree {
-                    self.on = false;
-                    self.basis.clear();
-                    self.images.clear();
+                    self.give_up();
                     return Ok(Some(solved));
                 }
             }
@@ -972,8 +974,14 @@ impl BoundLoad {
                     }
                     // q and q' in one pass over the factor of A
                     None => {
-                        let d: Vec<f64> = dv.iter().map(|x| x / d_div).collect();
-                        let mut qs = del.condense_many(&[base, &d]).map_err(hint)?;
+                        let scaled: Vec<f64>;
+                        let d: &[f64] = if d_div == 1.0 {
+                            &dv
+                        } else {
+                            scaled = dv.iter().map(|x| x / d_div).collect();
+                            &scaled
+                        };
+                        let mut qs = del.condense_many(&[base, d]).map_err(hint)?;
                         let dq = qs.pop().expect("two columns");
                         (qs.pop().expect("two columns"), dq)
                     }
