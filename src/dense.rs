@@ -254,6 +254,15 @@ pub(crate) fn inf_norm(v: &[f64]) -> f64 {
     }
 }
 
+/// `max_i |a_i − b_i|` (0 for empty slices); a NaN difference is skipped (`f64::max`), so
+/// callers compare vectors they know to be finite.
+pub(crate) fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
 /// `Σ a_i b_i` in eight independent lanes, compiled for the machine's vector instructions
 /// by faer's dispatch (a plain `.sum()` is one sequential chain of additions that the
 /// compiler may not reorder, about one addition per cycle).

@@ -20,7 +20,7 @@
 //! Either stops the path cleanly with [`crate::Error::Load`], keeping what was traced.
 
 use crate::condense::Delassus;
-use crate::dense::{axpy, dot, inf_norm};
+use crate::dense::{axpy, dot, inf_norm, max_abs_diff};
 use crate::error::{Error, Result};
 
 /// Why a load closure failed: the caller's own code (kept and reported) and a message.
@@ -390,13 +390,7 @@ impl Span {
                 let cols: Vec<&[f64]> = vs.iter().map(|(v, _)| *v).collect();
                 let solved = del.condense_many(&cols)?;
                 let agree = out.iter().zip(&solved).all(|(a, b)| {
-                    let scale = inf_norm(a).max(inf_norm(b));
-                    let diff = a
-                        .iter()
-                        .zip(b)
-                        .map(|(x, y)| (x - y).abs())
-                        .fold(0.0, f64::max);
-                    diff <= SPAN_CHECK_TOL * scale
+                    max_abs_diff(a, b) <= SPAN_CHECK_TOL * inf_norm(a).max(inf_norm(b))
                 });
                 if !agree {
                     self.give_up();

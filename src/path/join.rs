@@ -4,6 +4,7 @@
 
 use super::advance::GuardRow;
 use super::*;
+use crate::dense::max_abs_diff;
 
 /// The widest of `transit`'s last-resort thresholds, as a multiple of the usual ones.
 pub(super) const MAX_WIDENING: f64 = 64.0;
@@ -474,12 +475,8 @@ impl Path {
         let recent: Vec<(Vec<Class>, i8)> = {
             let tiny = |a0: f64, a1: f64, l0: &[f64], l1: &[f64]| {
                 let scale = inf_norm(l0).max(inf_norm(l1));
-                let dl = l0
-                    .iter()
-                    .zip(l1)
-                    .map(|(x, y)| (x - y).abs())
-                    .fold(0.0, f64::max);
-                (a1 - a0).abs() <= ROUNDING_LONG * a0.abs().max(1.0) && dl <= ROUNDING_LONG * scale
+                (a1 - a0).abs() <= ROUNDING_LONG * a0.abs().max(1.0)
+                    && max_abs_diff(l0, l1) <= ROUNDING_LONG * scale
             };
             let tr = self.trace.as_ref().expect("started");
             let mut out = Vec::new();
