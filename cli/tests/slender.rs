@@ -891,6 +891,36 @@ fn strip_p480() {
     slender("strip p = 480", strip(480), 1e-10);
 }
 
+/// A slender strip (401 × 3 nodes on (0, 40) × (0, 0.2), F = 3, an overlap of 1.1e-4)
+/// whose path ends on the window's edge on a piece entered 7e-4 before it: fricont took
+/// that end point from the piece's updated factorisation unchecked, with a residual of
+/// 1.3e-10 and an open node's λ 2e-6 of max|λ| off zero (found by a sweep that checks
+/// every piece's ends from A, N, T). The end's λ against the reference's (every
+/// comparison checks it), the events to 1e-10 as on the other strips.
+#[test]
+fn strip_ending_on_an_ill_conditioned_piece() {
+    let spec = RectSpec {
+        nx: 401,
+        ny: 3,
+        lx: 40.0,
+        ly: 0.2,
+        friction: 3.0,
+        gap: -0.00011,
+        load0: vec![
+            Traction::linear(Side::Top, [0.0069, -0.00866], [0.00021, -0.01031]),
+            Traction::uniform(Side::Right, [0.00948, -0.00793]),
+        ],
+        load1: vec![
+            Traction::linear(Side::Top, [-0.00111, -0.0055], [-0.00301, 0.00997]),
+            Traction::uniform(Side::Right, [0.00216, -0.00161]),
+        ],
+        alpha_start: -0.5,
+        alpha_end: 1.5,
+        ..RectSpec::default()
+    };
+    slender("strip 401 x 3, F = 3", spec, 1e-10);
+}
+
 /// The tracer alone on data exact in double: the reference's condensation of the beam
 /// rounded to double is given to fricont as condensed input (extended precision on: its
 /// transition points are polished in double-double) and to the reference as it is. Both

@@ -295,6 +295,18 @@ pub(super) struct RefinedPiece {
     pub(super) rounded: [Vec<f64>; 4],
 }
 
+impl RefinedPiece {
+    /// λ on the refined line at `alpha` (the piece entered at `alpha_e`), rounded to
+    /// double: `λ_e + (α − α_e) λ'` in double-double, the difference of the two α exact.
+    pub(super) fn lam_at(&self, alpha_e: f64, alpha: f64) -> Vec<f64> {
+        let (hi, lo) = crate::dd::two_sum(alpha, -alpha_e);
+        let s = Dd::new(hi, lo);
+        (0..self.lam_e.hi.len())
+            .map(|k| (self.lam_e.get(k) + self.lam_1.get(k) * s).to_f64())
+            .collect()
+    }
+}
+
 /// A double-double point `lam2` is taken for the double-precision one `lam` without
 /// further checks only where the two lie within [`NEAR`] of each other (relative to
 /// max|λ|, or to `floor` where that is larger: the force scale of the data, see

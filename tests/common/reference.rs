@@ -1301,6 +1301,9 @@ pub struct Comparison {
     pub reference: RefTrace,
     /// max |λ_fricont − λ_ref| / max |λ| at the start.
     pub start_diff: f64,
+    /// max |λ_fricont − λ_ref| / max |λ| at the window's end, on the last pieces of both
+    /// (0 when either did not reach it).
+    pub end_diff: f64,
     /// The comparison of the events: the largest relative α difference, or the first
     /// difference.
     pub events: Result<f64, String>,
@@ -1314,7 +1317,8 @@ impl Comparison {
     /// Everything agrees: the reference reached the window's end, fricont ended with
     /// reason `window` at the same α, the start states agree to `tol` (relative to the
     /// largest force; in double alone fricont's condensation was only accurate to 1e-7 on
-    /// the p = 480 strip, with extended precision its start agrees to ~1e-14), the events
+    /// the p = 480 strip, with extended precision its start agrees to ~1e-14), and so do
+    /// the λ at the window's end on the last pieces of both, the events
     /// agree ([`compare_events`] to `tol`) and neither path folds
     /// where the other does not. The message lists the first differing transition and the
     /// largest differences of single events ([`differences`]).
@@ -1328,6 +1332,12 @@ impl Comparison {
         let mut errs = Vec::new();
         if self.start_diff > tol {
             errs.push(format!("start λ differ by {:e}", self.start_diff));
+        }
+        if self.end_diff > tol {
+            errs.push(format!(
+                "λ at the window's end differ by {:e}",
+                self.end_diff
+            ));
         }
         if let Err(e) = &self.events {
             errs.push(e.clone());
@@ -1505,6 +1515,25 @@ pub fn compare_with_fricont(
         ),
     };
     let ref_secs = t.elapsed().as_secs_f64();
+    // The end point: fricont's last piece's end against the reference's last piece solved
+    // at the same α (nothing checks it as a transition point).
+    let end_diff = match (
+        path.pieces().last(),
+        reference.pieces.last(),
+        &reference.end,
+    ) {
+        (Some(pc), Some((classes, _, _)), Ok(())) if reason == "window" => {
+            let l_fr = DVector::from_column_slice(&pc.lambda_to);
+            match cond.piece(classes, pc.alpha_to) {
+                Ok(rp) => {
+                    let l = rp.lambda(pc.alpha_to);
+                    (&l - &l_fr).amax() / l.amax().max(l_fr.amax()).max(1e-300)
+                }
+                Err(_) => f64::INFINITY,
+            }
+        }
+        _ => 0.0,
+    };
     let want: Vec<Ev> = reference
         .events
         .iter()
@@ -1521,6 +1550,7 @@ pub fn compare_with_fricont(
         fricont_end: (end_alpha, reason),
         reference,
         start_diff,
+        end_diff,
         events,
         seconds: (fr_secs, ref_secs),
     }
