@@ -921,6 +921,63 @@ fn strip_ending_on_an_ill_conditioned_piece() {
     slender("strip 401 x 3, F = 3", spec, 1e-10);
 }
 
+/// A start on an extremely slender strip (801 × 3 nodes on (0, 80) × (0, 0.06), aspect
+/// 1333, κ(W) = 8e11, F = 0.3) where a node slips at α = 0 and sticks from α = 5.7e-4 on.
+/// At the double thresholds its small slip rate counted as zero, so the start took the
+/// stick piece (which lies 1.6e-3 of max|λ| away at α = 0, outside its cone) and never
+/// reported the node's transition; the start state had a residual of 8e-7 (found by the
+/// sweep that checks each piece's ends from A, N, T). Against the reference from the
+/// start over [0, 0.05] (its first 12 events; the reference itself refuses to start on a
+/// piece whose guards are negative there), to 1e-8, the acceptance for slender
+/// bodies (measured on this body: the start's λ 3.5e-9 of max|λ|, α 3.5e-10; the two
+/// condensations' roundings, amplified by κ(W) = 8e11).
+#[test]
+fn start_on_an_extremely_slender_strip() {
+    let spec = RectSpec {
+        nx: 801,
+        ny: 3,
+        lx: 80.0,
+        ly: 0.06,
+        friction: 0.3,
+        load0: vec![Traction::linear(
+            Side::Top,
+            [-0.00867, -0.01034],
+            [0.0084, -0.02619],
+        )],
+        load1: vec![Traction::linear(
+            Side::Top,
+            [0.00098, -0.0007],
+            [-0.00143, -0.00125],
+        )],
+        alpha_start: 0.0,
+        alpha_end: 0.05,
+        ..RectSpec::default()
+    };
+    let case = generate(&spec).expect("generate");
+    let c = compare_with_fricont(
+        &condensed(&case),
+        Arc::new(case.problem(None).expect("problem")),
+        &case.f0,
+        &case.f1,
+        case.alpha_start,
+        case.alpha_end,
+        1e-8,
+        &mut no_progress(),
+    );
+    if let Err(e) = c.check(1e-8) {
+        panic!(
+            "fricont {} events, reference {}: {e}",
+            c.fricont.len(),
+            c.reference.events.len()
+        );
+    }
+    assert!(
+        c.fricont.first().is_some_and(|e| e.0 < 1e-3),
+        "{:?}",
+        c.fricont.first()
+    );
+}
+
 /// The tracer alone on data exact in double: the reference's condensation of the beam
 /// rounded to double is given to fricont as condensed input (extended precision on: its
 /// transition points are polished in double-double) and to the reference as it is. Both

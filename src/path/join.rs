@@ -224,32 +224,13 @@ impl Path {
                 );
             }
             if enters {
-                let orientation = if s > 0.0 {
-                    lu_orientation
-                } else {
-                    -lu_orientation
-                };
-                let m = ts.len() - 1;
-                let det_sign = if scales.is_vertical(&ts) {
-                    0
-                } else {
-                    orientation * sign(ts[m])
-                };
-                let rate = if s > 0.0 {
-                    rate.clone()
-                } else {
-                    Arc::new(rate.iter().map(|v| -v).collect())
-                };
-                out.push(Candidate {
-                    orientation,
-                    classes: classes.to_vec(),
-                    t: ts,
-                    det_sign,
-                    lu: lu.clone(),
-                    scales,
-                    rate,
-                    xp: xp.clone(),
-                });
+                out.push(Candidate::along(
+                    classes,
+                    s,
+                    (&lu, lu_orientation, scales),
+                    (&t, &rate),
+                    xp.clone(),
+                ));
             }
         }
     }

@@ -380,6 +380,12 @@ const ROUNDING_LONG: f64 = 1e-8;
 /// terms use the own length itself (a factor of 1, see [`Path::term_rows`]).
 const FAR_WINDOW: f64 = 1e3;
 
+/// Most pieces the start point is refined on in extended precision before its classes
+/// settle ([`Path::start_on_its_piece`]); one or two in every case seen (an active-set
+/// iteration from the fixed-α solver's classes, which differ from the refined point's in
+/// a few nodes at most).
+const START_REFINE_ROUNDS: usize = 8;
+
 /// The per-row thresholds of displacement forms, computed on first use: row k costs one
 /// pass over row k of W (`(|W| |λ|)_k`), so a transition pays only for the rows it asks.
 #[derive(Debug)]
@@ -681,6 +687,44 @@ struct Candidate {
 }
 
 impl Candidate {
+    /// The piece `classes` along `s t` (s = ±1) from its tangent `t`, the rate of d along
+    /// `t` and its factorisation (`lu`, with the orientation of `t` and the scaling).
+    fn along(
+        classes: &[Class],
+        s: f64,
+        (lu, lu_orientation, scales): (&Arc<PieceSolver>, i8, JacobianScaling),
+        (t, rate): (&[f64], &Arc<Vec<f64>>),
+        xp: Option<Arc<Vec<f64>>>,
+    ) -> Candidate {
+        let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
+        let orientation = if s > 0.0 {
+            lu_orientation
+        } else {
+            -lu_orientation
+        };
+        let m = ts.len() - 1;
+        let det_sign = if scales.is_vertical(&ts) {
+            0
+        } else {
+            orientation * sign(ts[m])
+        };
+        let rate = if s > 0.0 {
+            rate.clone()
+        } else {
+            Arc::new(rate.iter().map(|v| -v).collect())
+        };
+        Candidate {
+            orientation,
+            classes: classes.to_vec(),
+            t: ts,
+            det_sign,
+            lu: lu.clone(),
+            scales,
+            rate,
+            xp,
+        }
+    }
+
     /// Sign of dα/ds along the candidate (0 for a vertical piece).
     fn direction(&self) -> i8 {
         if self.scales.is_vertical(&self.t) {
@@ -1677,16 +1721,20 @@ impl Path {
         let every: Vec<usize> = (0..p).collect();
         let mut all = self.compatible(&every, &pt, &tol);
         // The fixed-α solver's point is accurate to its residual (1e-12 of each node's
-        // scale) only, and on an ill-conditioned W a row whose terms are small can miss
-        // its threshold by that (a stick node's dt at 8.8e-14 against 7.6e-14, κ(W) =
-        // 1.2e6): in extended precision the point is then solved again on its piece (the
-        // classes of the solver's last Newton step) from the data, in double-double.
-        if all.iter().any(Vec::is_empty)
-            && let Some(lam) = self.start_on_its_piece(&pt, &qg)
-        {
+        // scale) only: on an ill-conditioned W a row whose terms are small can miss its
+        // threshold by that (a stick node's dt at 8.8e-14 against 7.6e-14, κ(W) = 1.2e6),
+        // and where κ(W) ε is large the point is off by that, so that its classes are not
+        // the solution's (κ(W) = 8e11: a node stuck at the double point whose solution
+        // slips; the start on that piece, refined, lay outside its cone by 1.6e-3 of
+        // max|λ|, with a residual of 8e-7). In extended precision the point is therefore
+        // always solved again on its piece from the data, in double-double, until its
+        // classes are those of the refined point.
+        let mut refined_classes = None;
+        if let Some((lam, classes)) = self.start_on_its_piece(&pt, &qg) {
             pt.lam = lam;
             tol = self.tol_at(&pt);
             all = self.compatible(&every, &pt, &tol);
+            refined_classes = Some(classes);
         }
         for (i, comp) in all.into_iter().enumerate() {
             match comp.len() {
@@ -1701,12 +1749,36 @@ impl Path {
             }
         }
         let want = sign(self.opts.alpha_end - self.opts.alpha_start);
-        let cands =
+        let mut cands =
             self.continuations_either(&pt, &fixed, &nodes, None, &mut Vec::new(), Widen::USUAL)?;
         let ms = 2 * p;
-        let toward: Vec<usize> = (0..cands.len())
+        let mut toward: Vec<usize> = (0..cands.len())
             .filter(|&k| cands[k].direction() == want)
             .collect();
+        // In extended precision a piece leaving the point toward alpha_end must pass
+        // through it in double-double too. Its degenerate nodes are found with the
+        // thresholds of double, which on an ill-conditioned W (κ = 8e11) let a slipping
+        // node's small dt count as zero: the path began to stick there, on a piece that
+        // lies 1.6e-3 of max|λ| away (its cone crossed by that), and the node's own
+        // transition, slip to stick 5.7e-4 further in α, was never reported. Where no
+        // candidate passes, the refined point's own piece leaves it (it is interior).
+        if self.problem.extended_precision() && !toward.is_empty() {
+            toward.retain(|&k| self.passes_through(&pt, &cands[k]));
+            if toward.is_empty() {
+                let interior = refined_classes
+                    .as_deref()
+                    .and_then(|classes| self.interior_candidate(&pt, classes, want));
+                let Some(cand) = interior else {
+                    return Err(Error::Numerical(format!(
+                        "no piece leaves the start point alpha = {alpha} toward alpha_end = {} \
+                         in double-double (each candidate of double precision lies off it)",
+                        self.opts.alpha_end
+                    )));
+                };
+                cands = vec![cand];
+                toward = vec![0];
+            }
+        }
         if let Some(&k) = toward.first() {
             self.begin(&pt, cands[k].clone(), want)?;
             if toward.len() > 1 {
@@ -1759,21 +1831,89 @@ impl Path {
     }
 
     /// The fixed-α solver's point `pt` (`qg = q(α) − (g, 0)`) solved again on the piece
-    /// of its projection classes and refined in double-double, its d kept for
-    /// [`Self::gaps`]. None in double, on a vertical piece, or when the refinement fails.
-    fn start_on_its_piece(&mut self, pt: &Point, qg: &[f64]) -> Option<Vec<f64>> {
+    /// of its projection classes and refined in double-double, until the refined point's
+    /// projection classes are those of the piece it was solved on (at most
+    /// [`START_REFINE_ROUNDS`] pieces: an active-set iteration in double-double); its d
+    /// kept for [`Self::gaps`]. None in double, on a vertical piece, or when a refinement
+    /// fails or the classes do not settle.
+    fn start_on_its_piece(&mut self, pt: &Point, qg: &[f64]) -> Option<(Vec<f64>, Vec<Class>)> {
         if !self.problem.extended_precision() {
             return None;
         }
-        let d = crate::piece::displacement_gaps(self.problem.delassus().w(), qg, &pt.lam);
-        let classes = crate::solve::active_classes(&self.consts(), &pt.lam, &d, None);
-        let piece = self.tangent(&classes, pt, self.force_scale(pt))?;
-        if piece.scales.is_vertical(&piece.t) {
+        let mut cur = pt.clone();
+        let mut d = crate::piece::displacement_gaps(self.problem.delassus().w(), qg, &pt.lam);
+        let mut classes = crate::solve::active_classes(&self.consts(), &cur.lam, &d, None);
+        for _ in 0..START_REFINE_ROUNDS {
+            let piece = self.tangent(&classes, &cur, self.force_scale(&cur))?;
+            if piece.scales.is_vertical(&piece.t) {
+                return None;
+            }
+            let (lam, d_new) = self.polish_point(&classes, &piece.lu, cur.alpha, &cur.lam)?;
+            (cur.lam, d) = (lam, d_new);
+            let next = crate::solve::active_classes(&self.consts(), &cur.lam, &d, None);
+            if next == classes {
+                self.prime_gaps(cur.alpha, &cur.lam, d);
+                return Some((cur.lam, classes));
+            }
+            classes = next;
+        }
+        None
+    }
+
+    /// The piece `classes` leaving `pt` toward `want` (the sign of α's way), where `pt` is
+    /// inside its region: every guard strictly positive (in extended precision, from the
+    /// refined point's d). None on a vertical piece, a singular one, or a guard at zero or
+    /// below.
+    fn interior_candidate(&mut self, pt: &Point, classes: &[Class], want: i8) -> Option<Candidate> {
+        if self
+            .guard_table(classes, pt, None)
+            .iter()
+            .any(|g| g.value <= 0.0 || g.value.is_nan())
+        {
             return None;
         }
-        let (lam, d) = self.polish_point(&classes, &piece.lu, pt.alpha, &pt.lam)?;
-        self.prime_gaps(pt.alpha, &lam, d);
-        Some(lam)
+        let PieceTangent {
+            t,
+            lu,
+            scales,
+            orientation,
+            rate,
+            xp,
+        } = self.tangent(classes, pt, self.force_scale(pt))?;
+        if scales.is_vertical(&t) {
+            return None;
+        }
+        let s = if sign(t[t.len() - 1]) == want {
+            1.0
+        } else {
+            -1.0
+        };
+        Some(Candidate::along(
+            classes,
+            s,
+            (&Arc::new(lu), orientation, scales),
+            (&t, &Arc::new(rate)),
+            xp.map(Arc::new),
+        ))
+    }
+
+    /// Whether candidate `cand`'s piece passes through the start point `pt` in
+    /// double-double: its point at `pt`'s α refined from `pt` still has every node in its
+    /// class (to the point's thresholds). True where there is no refinement (double
+    /// precision, a vertical piece, a refinement that fails): [`Self::begin`] then keeps
+    /// `pt` itself.
+    fn passes_through(&mut self, pt: &Point, cand: &Candidate) -> bool {
+        if cand.scales.is_vertical(&cand.t) {
+            return true;
+        }
+        let Some((lam, d)) = self.polish_point(&cand.classes, &cand.lu, pt.alpha, &pt.lam) else {
+            return true;
+        };
+        let tol = self.tol_at(pt);
+        (0..cand.classes.len()).all(|i| {
+            self.compatible_at(i, &lam, &d, &tol)
+                .contains(&cand.classes[i])
+        })
     }
 
     /// Starts the trace at `pt` on candidate `cand` (`want`: the sign of α's way toward
