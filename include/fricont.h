@@ -1591,8 +1591,9 @@ fricont_status fricont_path_choose_branch(struct fricont_path *path,
  * it: several past a fold; a transition point shared by two pieces once) and keeps them
  * in the handle; `*count` (not NULL) receives their number (0 if the traced path never
  * reached `alpha`). Read them with `fricont_path_solution`. Each costs one small solve
- * on the stored piece and one back-solve for u; may call the load callback. Replaces the
- * solutions of an earlier call.
+ * on the stored piece (under a nonlinear load, refined in double-double where the
+ * problem is carried in extended precision, as the traced points are) and one back-solve
+ * for u; may call the load callback. Replaces the solutions of an earlier call.
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE` (α not finite),
  * `FRICONT_ERR_ORDER` (not started), `FRICONT_ERR_CALLBACK`, `FRICONT_ERR_CALLBACK_VALUE`,

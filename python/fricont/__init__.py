@@ -308,8 +308,9 @@ class Path:
 
     def solutions_at(self, alpha: float) -> list:
         """Every traced solution at ``alpha`` (several past a fold), as :class:`Solution`
-        objects: one small solve on each stored piece whose alpha range contains it, plus a
-        back-solve for u. Empty where the traced path never reached ``alpha``;
+        objects: one small solve on each stored piece whose alpha range contains it
+        (under a nonlinear load refined in double-double where ``extended_precision`` is
+        on, as the traced points are), plus a back-solve for u. Empty where the traced path never reached ``alpha``;
         ``ValueError`` when ``alpha`` is not finite."""
         out = []
         for piece, st, continuum in self._core.solutions_at(float(alpha)):

@@ -753,6 +753,14 @@ enum PieceSolver {
 }
 
 impl PieceSolver {
+    /// The updated factorisation, where this is one.
+    fn updated(&self) -> Option<&UpdatedLu> {
+        match self {
+            PieceSolver::Updated(u) => Some(u),
+            PieceSolver::Full(_) => None,
+        }
+    }
+
     /// A solution `x` (raw coordinates (λ, α)) of `J x = b`. The updated form returns the
     /// one at `near_alpha` (`x_α = near_alpha`, the α of the current point), so that no cancellation
     /// with a far-away α = 0 enters.

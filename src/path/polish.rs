@@ -322,13 +322,14 @@ pub(super) fn near(lam2: &[f64], lam: &[f64], floor: f64) -> bool {
 }
 
 impl Path {
-    /// The [`Refiner`] of the piece `classes` solved by `lu`; None when the problem is not
-    /// carried beyond double (see the module doc) or the load is a general one.
+    /// The [`Refiner`] of the piece `classes`, solved by its updated factorisation
+    /// `updated` where given, else by a fresh LU of its matrix; None when the problem is
+    /// not carried beyond double (see the module doc).
     fn refiner<'a>(
         &mut self,
         problem: &'a Problem,
         classes: &'a [Class],
-        lu: &'a PieceSolver,
+        updated: Option<&'a update::UpdatedLu>,
     ) -> Option<Refiner<'a>> {
         if !self.problem.extended_precision() {
             return None;
@@ -354,11 +355,11 @@ impl Path {
         };
         let w = del.w();
         let row_bound = self.row_bound();
-        let solve: PieceSolve<'a> = match lu {
+        let solve: PieceSolve<'a> = match updated {
             // Checked solves (each refined once in double where its residual is above
             // rounding level): each outer round then contracts by about (κ ε)², not κ ε,
             // on pieces near the limit of double precision.
-            PieceSolver::Updated(u) => Box::new(move |bs: &[Vec<f64>]| {
+            Some(u) => Box::new(move |bs: &[Vec<f64>]| {
                 let cols: Vec<update::Rhs<'_>> =
                     bs.iter().map(|b| update::Rhs { b, guess: None }).collect();
                 u.solve_checked_many(&c, w, &cols, row_bound)
@@ -366,7 +367,7 @@ impl Path {
                     .map(|k| k.x)
                     .collect()
             }),
-            PieceSolver::Full(_) => {
+            None => {
                 let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
                 Box::new(move |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect())
             }
@@ -396,7 +397,7 @@ impl Path {
     ) -> Option<Vec<(Vec<f64>, Vec<f64>)>> {
         let m = 2 * self.problem.p();
         let problem = self.problem.clone();
-        let r = self.refiner(&problem, &cur.classes, &cur.lu)?;
+        let r = self.refiner(&problem, &cur.classes, cur.lu.updated())?;
         let k = r.q.len();
         if ys.len() != k + 1 {
             return None;
@@ -443,12 +444,24 @@ impl Path {
         alpha: f64,
         lam: &[f64],
     ) -> Option<(Vec<f64>, Vec<f64>)> {
+        self.polish_point_by(classes, lu.updated(), alpha, lam)
+    }
+
+    /// [`Self::polish_point`] with the piece solved by its updated factorisation
+    /// `updated` where given, else by a fresh LU of its matrix.
+    pub(super) fn polish_point_by(
+        &mut self,
+        classes: &[Class],
+        updated: Option<&update::UpdatedLu>,
+        alpha: f64,
+        lam: &[f64],
+    ) -> Option<(Vec<f64>, Vec<f64>)> {
         let problem = self.problem.clone();
         if !self.load.is_affine() {
             // A basis load's weights at α, a general load's q(α) (the refiner's).
             self.load.q(alpha, problem.delassus()).ok()?;
         }
-        let r = self.refiner(&problem, classes, lu)?;
+        let r = self.refiner(&problem, classes, updated)?;
         let c = if self.load.is_affine() {
             r.point_constant(alpha)
         } else if self.load.basis_vectors().is_some() {
@@ -496,7 +509,7 @@ impl Path {
         }
         let m = 2 * self.problem.p();
         let problem = self.problem.clone();
-        let r = self.refiner(&problem, &cur.classes, &cur.lu)?;
+        let r = self.refiner(&problem, &cur.classes, cur.lu.updated())?;
         let start = match &cur.xp {
             Some(xp) => xp.to_vec(),
             None => cur.lam.clone(),
