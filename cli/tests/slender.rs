@@ -1075,6 +1075,84 @@ fn solutions_at_under_nonlinear_loads_on_a_slender_strip() {
     }
 }
 
+/// `solutions_at` on pieces traced long before, under a general load on a slender body
+/// (301 × 21 nodes on 30 × 0.6, κ(W) = 3e7, F = 0.3; `φ(α) = α + A sin(ω (α + 2))` with
+/// A ω = 3.1, so the path folds): the path's factorisation reaches such a piece by updates
+/// whose solve fails its check, and the refinement in double-double that then solved by
+/// that update did not converge: the point stayed in double (residual 7.8e-8; the
+/// general load's q(α) is a solve with A). The refinement now solves as the point did,
+/// by a fresh LU there. Every piece's midpoint against the reference's piece at φ(α), to
+/// 1e-9 of max|λ| (found by the sweep that checks queried points from A, N, T).
+#[test]
+fn solutions_at_on_earlier_pieces_under_a_general_load() {
+    let spec = RectSpec {
+        nx: 301,
+        ny: 21,
+        lx: 30.0,
+        ly: 0.6,
+        friction: 0.3,
+        load0: vec![
+            Traction::linear(Side::Top, [-0.00043, -0.02702], [-0.00479, -0.00537]),
+            Traction::uniform(Side::Right, [-0.00772, -0.00385]),
+        ],
+        load1: vec![Traction::linear(
+            Side::Top,
+            [-0.00611, -0.00583],
+            [-0.00307, 0.00252],
+        )],
+        ..RectSpec::default()
+    };
+    let case = generate(&spec).expect("generate");
+    let cond = condensed(&case);
+    let problem = Arc::new(case.problem(None).expect("problem"));
+    assert!(problem.extended_precision());
+    let (amp, omega) = (0.2, 2.0 * std::f64::consts::PI * 10.0 / 4.0);
+    let phi = move |a: f64| a + amp * (omega * (a + 2.0)).sin();
+    let dphi = move |a: f64| 1.0 + amp * omega * (omega * (a + 2.0)).cos();
+    let (f0, f1, f1d) = (case.f0.clone(), case.f1.clone(), case.f1.clone());
+    let load = fricont::Load::general(
+        f0.len(),
+        Box::new(move |a: f64, out: &mut [f64]| {
+            for ((o, x), y) in out.iter_mut().zip(&f0).zip(&f1) {
+                *o = x + phi(a) * y;
+            }
+            Ok(())
+        }),
+        Some(Box::new(move |a: f64, out: &mut [f64]| {
+            for (o, y) in out.iter_mut().zip(&f1d) {
+                *o = dphi(a) * y;
+            }
+            Ok(())
+        })),
+    );
+    let mut path =
+        fricont::Path::new(problem, load, fricont::PathOptions::window(0.6, 1.3)).expect("path");
+    path.start(0.6, None).expect("start");
+    path.run().expect("run");
+    assert!(path.events().len() >= 40, "{} events", path.events().len());
+    let pieces = path.pieces().to_vec();
+    let mut worst: f64 = 0.0;
+    for pc in &pieces {
+        let alpha = 0.5 * (pc.alpha_from + pc.alpha_to);
+        for sol in path.solutions_at(alpha).expect("solutions_at") {
+            let st = &sol.state;
+            let r = cond
+                .piece(&st.classes, phi(alpha))
+                .expect("reference piece")
+                .lambda(phi(alpha));
+            let got: Vec<f64> = st.lambda_n.iter().chain(&st.lambda_t).copied().collect();
+            let diff = r
+                .iter()
+                .zip(&got)
+                .fold(0f64, |m, (a, b)| m.max((a - b).abs()))
+                / r.amax();
+            assert!(diff <= 1e-9, "α = {alpha}: λ differ by {diff:e}");
+            worst = worst.max(diff);
+        }
+    }
+    eprintln!("{} pieces, worst {worst:e}", pieces.len());
+}
+
 /// The tracer alone on data exact in double: the reference's condensation of the beam
 /// rounded to double is given to fricont as condensed input (extended precision on: its
 /// transition points are polished in double-double) and to the reference as it is. Both

@@ -806,9 +806,16 @@ impl Path {
                     // A general load on a problem carried beyond double: the point refined
                     // in double-double (the solves at neighbouring α otherwise differ by
                     // cond · ε, more than the guards' thresholds on a slender body), its d
-                    // from it; the rates stay in double.
+                    // from it; the rates stay in double. Refined by solves as the point
+                    // was: the updated factorisation, or a fresh LU where its check failed
+                    // (with the failing update, the refinement did not converge and the
+                    // double point was kept).
+                    let by = match dense.get() {
+                        Some(_) => None,
+                        None => cur.lu.updated(),
+                    };
                     if basis.is_none()
-                        && let Some(refined) = this.polish_point(&classes, &cur.lu, alpha, &lam)
+                        && let Some(refined) = this.polish_point_by(&classes, by, alpha, &lam)
                     {
                         (lam, d) = refined;
                     }

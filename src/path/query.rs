@@ -328,20 +328,25 @@ impl Path {
                     .filter(|u| u.reaches(&pc.classes))
                     .and_then(|u| u.extend(&c, w, &pc.classes, None, &[]))
                     .map(|(u, _)| u);
-                let updated = solver
-                    .as_ref()
-                    .map(|u| u.solve_checked(&c, w, &rhs, self.row_bound()))
-                    .filter(|k| k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()))
-                    .map(|k| k.x);
-                let lam = updated.unwrap_or_else(|| {
-                    DenseLu::new(c.piece_matrix(w, &pc.classes).as_ref()).solve(&rhs)
+                let checked = solver.and_then(|u| {
+                    let k = u.solve_checked(&c, w, &rhs, self.row_bound());
+                    (k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite())).then_some((u, k.x))
                 });
+                let (lam, updated) = match checked {
+                    Some((u, x)) => (x, Some(u)),
+                    None => (
+                        DenseLu::new(c.piece_matrix(w, &pc.classes).as_ref()).solve(&rhs),
+                        None,
+                    ),
+                };
                 // In extended precision refined in double-double, as the march's points
                 // are: in double, q(α) of a general load (a solve with A) and the piece
                 // solve are each off by their condition times ε (on a strip with
-                // κ(W) = 1.6e10 the point was 5.5e-5 of max|λ| off, residual 1e-6).
+                // κ(W) = 1.6e10 the point was 5.5e-5 of max|λ| off, residual 1e-6). The
+                // refinement solves as the point did: by the update where its check
+                // passed, else by a fresh LU.
                 let lam = self
-                    .polish_point_by(&pc.classes, solver.as_ref(), alpha, &lam)
+                    .polish_point_by(&pc.classes, updated.as_ref(), alpha, &lam)
                     .map_or(lam, |(l, _)| l);
                 lams.push(lam);
             }
