@@ -311,6 +311,34 @@ fn slender(name: &str, spec: RectSpec, tol: f64) {
     );
 }
 
+/// fricont against the reference on the rectangle of `spec` over its window, to `tol`
+/// ([`common::reference::Comparison::check`]); panics naming `name` where they differ.
+fn checked_against_reference(
+    name: &str,
+    spec: &RectSpec,
+    tol: f64,
+) -> common::reference::Comparison {
+    let case = generate(spec).expect("generate");
+    let c = compare_with_fricont(
+        &condensed(&case),
+        Arc::new(case.problem(None).expect("problem")),
+        &case.f0,
+        &case.f1,
+        case.alpha_start,
+        case.alpha_end,
+        tol,
+        &mut no_progress(),
+    );
+    if let Err(e) = c.check(tol) {
+        panic!(
+            "{name}: fricont {} events, reference {}: {e}",
+            c.fricont.len(),
+            c.reference.events.len()
+        );
+    }
+    c
+}
+
 /// Random rectangles against the reference, to 1e-8 (relative to max(1, |α|), the issue's
 /// acceptance): 8 to 67 × 2 to 9 nodes on sides of 0.5–8 × 0.1–3, friction 0.05 to 5, a
 /// uniform gap of either sign (up to 1e-3) on every third, a random linearly varying
@@ -355,25 +383,7 @@ fn random_rectangles() {
             "seed {seed}: {} x {} nodes on {:.2} x {:.2}, F = {}, gap {:e}",
             spec.nx, spec.ny, spec.lx, spec.ly, spec.friction, spec.gap
         );
-        let case = generate(&spec).expect("generate");
-        let c = compare_with_fricont(
-            &condensed(&case),
-            Arc::new(case.problem(None).expect("problem")),
-            &case.f0,
-            &case.f1,
-            case.alpha_start,
-            case.alpha_end,
-            1e-8,
-            &mut no_progress(),
-        );
-        if let Err(e) = c.check(1e-8) {
-            panic!(
-                "{name}: fricont {} events, reference {}: {e}",
-                c.fricont.len(),
-                c.reference.events.len()
-            );
-        }
-        folds += c.folds.0;
+        folds += checked_against_reference(&name, &spec, 1e-8).folds.0;
     }
     assert!(folds > 0, "no fold among the rectangles");
 }
@@ -953,24 +963,7 @@ fn start_on_an_extremely_slender_strip() {
         alpha_end: 0.05,
         ..RectSpec::default()
     };
-    let case = generate(&spec).expect("generate");
-    let c = compare_with_fricont(
-        &condensed(&case),
-        Arc::new(case.problem(None).expect("problem")),
-        &case.f0,
-        &case.f1,
-        case.alpha_start,
-        case.alpha_end,
-        1e-8,
-        &mut no_progress(),
-    );
-    if let Err(e) = c.check(1e-8) {
-        panic!(
-            "fricont {} events, reference {}: {e}",
-            c.fricont.len(),
-            c.reference.events.len()
-        );
-    }
+    let c = checked_against_reference("strip 801 x 3", &spec, 1e-8);
     assert!(
         c.fricont.first().is_some_and(|e| e.0 < 1e-3),
         "{:?}",
