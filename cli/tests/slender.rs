@@ -271,19 +271,7 @@ fn condensed(case: &fricont_exchange::io::CaseData) -> Condensed {
 /// fricont against the reference on a generated rectangle (press-shear load, window
 /// [−0.5, 1.5]).
 fn slender(name: &str, spec: RectSpec, tol: f64) {
-    let case = generate(&spec).expect("generate");
-    let cond = condensed(&case);
-    let problem = Arc::new(case.problem(None).expect("problem"));
-    let c = compare_with_fricont(
-        &cond,
-        problem,
-        &case.f0,
-        &case.f1,
-        case.alpha_start,
-        case.alpha_end,
-        tol,
-        &mut no_progress(),
-    );
+    let c = traced_against_reference(&spec, tol);
     // The reference's own health: accurate piece solves, no crossings grouped into one
     // transition that were not simultaneous.
     let r = &c.reference;
@@ -311,15 +299,11 @@ fn slender(name: &str, spec: RectSpec, tol: f64) {
     );
 }
 
-/// fricont against the reference on the rectangle of `spec` over its window, to `tol`
-/// ([`common::reference::Comparison::check`]); panics naming `name` where they differ.
-fn checked_against_reference(
-    name: &str,
-    spec: &RectSpec,
-    tol: f64,
-) -> common::reference::Comparison {
+/// fricont and the reference traced on the rectangle of `spec` over its window, compared
+/// to `tol` (not checked).
+fn traced_against_reference(spec: &RectSpec, tol: f64) -> common::reference::Comparison {
     let case = generate(spec).expect("generate");
-    let c = compare_with_fricont(
+    compare_with_fricont(
         &condensed(&case),
         Arc::new(case.problem(None).expect("problem")),
         &case.f0,
@@ -328,7 +312,17 @@ fn checked_against_reference(
         case.alpha_end,
         tol,
         &mut no_progress(),
-    );
+    )
+}
+
+/// [`traced_against_reference`], checked ([`common::reference::Comparison::check`]):
+/// panics naming `name` where they differ.
+fn checked_against_reference(
+    name: &str,
+    spec: &RectSpec,
+    tol: f64,
+) -> common::reference::Comparison {
+    let c = traced_against_reference(spec, tol);
     if let Err(e) = c.check(tol) {
         panic!(
             "{name}: fricont {} events, reference {}: {e}",
@@ -971,6 +965,20 @@ fn start_on_an_extremely_slender_strip() {
     );
 }
 
+/// How far the state's λ lies from the reference's piece of its classes at the affine
+/// load's parameter `s` (max |Δλ| / max |λ_ref|).
+fn off_reference(cond: &Condensed, st: &fricont::path::State, s: f64) -> f64 {
+    let r = cond
+        .piece(&st.classes, s)
+        .expect("reference piece")
+        .lambda(s);
+    let got = st.lambda_n.iter().chain(&st.lambda_t);
+    r.iter()
+        .zip(got)
+        .fold(0f64, |m, (a, b)| m.max((a - b).abs()))
+        / r.amax()
+}
+
 /// `solutions_at` under nonlinear loads on a slender strip (301 × 3 nodes on 30 × 0.06,
 /// κ(W) = 1.6e10, F = 1, an overlap of 5e-4; every node sticks over the window): the
 /// load `f0 + φ(α) f1`, `φ(α) = α + A sin(ω (α − α_start))`, as a general load with its
@@ -1049,16 +1057,7 @@ fn solutions_at_under_nonlinear_loads_on_a_slender_strip() {
             let sols = path.solutions_at(alpha).expect(name);
             assert_eq!(sols.len(), 1, "{name} at {alpha}");
             let st = &sols[0].state;
-            let r = cond
-                .piece(&st.classes, phi(alpha))
-                .expect("reference piece")
-                .lambda(phi(alpha));
-            let got: Vec<f64> = st.lambda_n.iter().chain(&st.lambda_t).copied().collect();
-            let diff = r
-                .iter()
-                .zip(&got)
-                .fold(0f64, |m, (a, b)| m.max((a - b).abs()))
-                / r.amax();
+            let diff = off_reference(&cond, st, phi(alpha));
             assert!(diff <= 1e-9, "{name} at α = {alpha}: λ differ by {diff:e}");
             eprintln!(
                 "{name} at α = {alpha}: {diff:e}, residual {:e}",
@@ -1128,17 +1127,7 @@ fn solutions_at_on_earlier_pieces_under_a_general_load() {
     for pc in &pieces {
         let alpha = 0.5 * (pc.alpha_from + pc.alpha_to);
         for sol in path.solutions_at(alpha).expect("solutions_at") {
-            let st = &sol.state;
-            let r = cond
-                .piece(&st.classes, phi(alpha))
-                .expect("reference piece")
-                .lambda(phi(alpha));
-            let got: Vec<f64> = st.lambda_n.iter().chain(&st.lambda_t).copied().collect();
-            let diff = r
-                .iter()
-                .zip(&got)
-                .fold(0f64, |m, (a, b)| m.max((a - b).abs()))
-                / r.amax();
+            let diff = off_reference(&cond, &sol.state, phi(alpha));
             assert!(diff <= 1e-9, "α = {alpha}: λ differ by {diff:e}");
             worst = worst.max(diff);
         }
