@@ -538,24 +538,15 @@ impl Path {
                 let pt = self.point_at(vec![0.0; m], alpha)?;
                 let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
                 let rhs = c.piece_rhs(&cur.classes, &qg);
-                let fresh = || DenseLu::new(c.piece_matrix(w, &cur.classes).as_ref()).solve(&rhs);
                 // The window's edge ends the path without a transition point's checks, so
                 // it is solved from the data: on the refined line where the piece was
                 // refined, else by the updated factorisation where its residual passes
                 // (1e-12), else by one LU of M_S. The updated solve was once kept
                 // unchecked: on a slender strip (F = 3, p = 400) its residual was 1.3e-10
                 // and an open node's λ 2e-6 of max|λ| off zero at the window's end.
-                let lam = match (&refined, &*cur.lu) {
-                    (Some(r), _) => r.lam_at(cur.alpha, alpha),
-                    (None, PieceSolver::Updated(u)) => {
-                        let k = u.solve_checked(&c, w, &rhs, self.row_bound());
-                        if k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()) {
-                            k.x
-                        } else {
-                            fresh()
-                        }
-                    }
-                    (None, PieceSolver::Full(_)) => fresh(),
+                let lam = match &refined {
+                    Some(r) => r.lam_at(cur.alpha, alpha),
+                    None => self.piece_solve(&cur.classes, cur.lu.updated(), &rhs).0,
                 };
                 Ok(Exit::Window(Point { lam, ..pt }))
             }

@@ -962,6 +962,28 @@ impl Path {
         PieceConstants::of(&self.problem)
     }
 
+    /// λ of the piece `classes` for the right-hand side `rhs` (the seed's rows), from the
+    /// data: by the updated factorisation `updated` where its solve passes its check (a
+    /// relative residual of at most 1e-12, every entry finite), else by one LU of M_S.
+    /// The flag says whether the update served.
+    fn piece_solve(
+        &self,
+        classes: &[Class],
+        updated: Option<&UpdatedLu>,
+        rhs: &[f64],
+    ) -> (Vec<f64>, bool) {
+        let c = self.consts();
+        let w = self.problem.delassus().w();
+        if let Some(u) = updated {
+            let k = u.solve_checked(&c, w, rhs, self.row_bound());
+            if k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite()) {
+                return (k.x, true);
+            }
+        }
+        let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
+        (lu.solve(rhs), false)
+    }
+
     fn point_at(&mut self, lam: Vec<f64>, alpha: f64) -> Result<Point> {
         let (q, dq) = self.load.q(alpha, self.problem.delassus())?;
         let dw = self.load.weights_at(alpha).map(|(_, dw)| dw.to_vec());

@@ -300,7 +300,12 @@ impl RefinedPiece {
     /// double: `λ_e + (α − α_e) λ'` in double-double, the difference of the two α exact.
     pub(super) fn lam_at(&self, alpha_e: f64, alpha: f64) -> Vec<f64> {
         let (hi, lo) = crate::dd::two_sum(alpha, -alpha_e);
-        let s = Dd::new(hi, lo);
+        self.lam_along(Dd::new(hi, lo))
+    }
+
+    /// λ on the refined line `s` along α from its entry, `λ_e + s λ'` in double-double,
+    /// rounded to double.
+    fn lam_along(&self, s: Dd) -> Vec<f64> {
         (0..self.lam_e.hi.len())
             .map(|k| (self.lam_e.get(k) + self.lam_1.get(k) * s).to_f64())
             .collect()
@@ -577,9 +582,7 @@ impl Path {
         if !(lo..=hi).contains(&alpha) {
             return None;
         }
-        let lam: Vec<f64> = (0..m)
-            .map(|k| (r.lam_e.get(k) + r.lam_1.get(k) * s).to_f64())
-            .collect();
+        let lam = r.lam_along(s);
         (alpha.is_finite() && lam.iter().all(|v| v.is_finite())).then_some((lam, alpha, g))
     }
 }

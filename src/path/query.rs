@@ -328,17 +328,8 @@ impl Path {
                     .filter(|u| u.reaches(&pc.classes))
                     .and_then(|u| u.extend(&c, w, &pc.classes, None, &[]))
                     .map(|(u, _)| u);
-                let checked = solver.and_then(|u| {
-                    let k = u.solve_checked(&c, w, &rhs, self.row_bound());
-                    (k.rel <= 1e-12 && k.x.iter().all(|v| v.is_finite())).then_some((u, k.x))
-                });
-                let (lam, updated) = match checked {
-                    Some((u, x)) => (x, Some(u)),
-                    None => (
-                        DenseLu::new(c.piece_matrix(w, &pc.classes).as_ref()).solve(&rhs),
-                        None,
-                    ),
-                };
+                let (lam, by_update) = self.piece_solve(&pc.classes, solver.as_ref(), &rhs);
+                let updated = solver.filter(|_| by_update);
                 // In extended precision refined in double-double, as the march's points
                 // are: in double, q(α) of a general load (a solve with A) and the piece
                 // solve are each off by their condition times ε (on a strip with
