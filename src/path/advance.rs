@@ -369,24 +369,22 @@ impl Path {
     }
 
     /// The point `pt` where a piece ends at the zero of guard `g`, moved along the piece's
-    /// tangent to that zero where α cannot resolve it: λ and d by the Newton step, α by
+    /// tangent to that zero where the root's search in α could not reach it (α cannot
+    /// resolve it, or the load's solutions are noisier than the guard's threshold, see the
+    /// general-load arm of [`Self::exit_graph`]'s root): λ and d by the Newton step, α by
     /// it rounded. `tangent`: dλ/dα and dd/dα at `pt` (computed only where the point
-    /// moves; None: it stays); `within`: the stretch of α the
-    /// root was found on, and `max_step` the longest step in α taken (a step beyond either
-    /// is not taken: a general load's guards far above their thresholds at scales near
-    /// the largest double asked for a step of 7e-3 in α). Near a fold the guard's slope
-    /// per unit α was 1e4 (basis load): neighbouring doubles of α straddled its zero at
-    /// ±2.5e-14; on a piece with dα/ds = 3.9e-5 (general load, slender strip, F = 5) the
-    /// normal force of the node lifting off was −4.5e-12 at the root's double, 1.7 times
-    /// its threshold, and no piece continued the path. Moved where the guard is beyond
-    /// [`Self::root_accept`].
+    /// moves; None: it stays); `within`: the stretch of α the root was found on (a step
+    /// beyond it is not taken). Near a fold the guard's slope per unit α was 1e4 (basis
+    /// load): neighbouring doubles of α straddled its zero at ±2.5e-14; on a piece with
+    /// dα/ds = 3.9e-5 (general load, slender strip, F = 5) the normal force of the node
+    /// lifting off was −4.5e-12 at the root's double, 1.7 times its threshold, and no piece
+    /// continued the path. Moved where the guard is beyond [`Self::root_accept`].
     fn onto_guard_zero(
         &mut self,
         pt: Point,
         g: Guard,
         tangent: impl FnOnce(&Self, &Point) -> Option<[Vec<f64>; 2]>,
         (lo, hi): (f64, f64),
-        max_step: f64,
     ) -> Result<Point> {
         let form = self.consts().guard_form(g);
         let d = self.gaps(&pt);
@@ -398,7 +396,7 @@ impl Path {
             return Ok(pt);
         };
         let step = -v / form.eval(&t, &rate);
-        if !(step.is_finite() && step.abs() <= max_step && (lo..=hi).contains(&(pt.alpha + step))) {
+        if !(step.is_finite() && (lo..=hi).contains(&(pt.alpha + step))) {
             return Ok(pt);
         }
         self.step_along(pt.alpha, (&pt.lam, &d), (&t, &rate), step)
@@ -1327,20 +1325,30 @@ impl Path {
                     let [_, _, t, rate] = bs.at(w, dw, &qg, &pt.dq);
                     Some([t, rate])
                 };
-                pt = self.onto_guard_zero(pt, g, tangent, (lo_a, hi_a), f64::INFINITY)?;
+                pt = self.onto_guard_zero(pt, g, tangent, (lo_a, hi_a))?;
                 if let Some(p) = self.polish_root(cur, bs, (k, slope), (lo_a, hi_a), &pt)? {
                     pt = p;
                 }
             } else if basis.is_none() {
-                // A general load's root, in α, as above, by a step of a few roundings of
-                // α at most (where α cannot resolve it; its root was found in α).
+                // A general load's root, in α, as above. The load is given in double at
+                // each α: the rounding of each entry of f(α) (ε |f|, in no direction along
+                // the path) moves the piece's solution by its conditioning times that, a
+                // noise from α to α that no refinement of the solves removes, and the
+                // root's search in α ends where that noise hides the guard's sign. On a
+                // slender strip (F = 5, κ(W) ~ 1e8, carried in extended precision) a cone
+                // guard's values at neighbouring doubles of α went +3.9e-11, −2.0e-11,
+                // +1.2e-11 (threshold 3.5e-11, slope −1.1e4 per unit α), on another
+                // ±6e-10 (threshold 6.5e-12): the search ended with the guard at 1.1 and
+                // 49 times its threshold, the node fitted one class or none, and the path
+                // stopped. Moved along the piece's tangent by −v/γ' (3.5e-15 and 8.7e-14
+                // in α), the point is at the guard's zero, as far from the data as that
+                // noise.
                 let tangent = |this: &Self, pt: &Point| {
                     let qg = shift_gap(&pt.q, this.problem.gap_equilibrated());
                     let [_, _, t, rate] = solve(this, &qg, &pt.dq);
                     Some([t, rate])
                 };
-                let max_step = 4.0 * f64::EPSILON * pt.alpha.abs();
-                pt = self.onto_guard_zero(pt, g, tangent, (lo_a, hi_a), max_step)?;
+                pt = self.onto_guard_zero(pt, g, tangent, (lo_a, hi_a))?;
             }
             return Ok(Exit::Guards(pt, vec![g]));
         }
