@@ -138,9 +138,10 @@ fn main() {
         trace.push(t.elapsed().as_secs_f64());
         std::hint::black_box(path.events().len());
         summary = format!(
-            "{} events, {} pieces, end: {}",
+            "{} events, {} pieces, {} refactorisations, end: {}",
             path.events().len(),
             path.pieces().len(),
+            path.refactorisations(),
             end.name()
         );
     }
