@@ -400,14 +400,11 @@ impl DenseLu {
                     .try_as_col_major_mut()
                     .expect("an owned matrix's column is contiguous")
                     .as_slice_mut();
-                let col = w.col(c);
-                let terms = dst.iter_mut().zip(&disp).filter(|(_, t)| t.1 != 0.0);
-                match col.try_as_col_major() {
-                    Some(col) => {
-                        let col = col.as_slice();
-                        terms.for_each(|(o, &(k, a))| *o = a * col[k]);
-                    }
-                    None => terms.for_each(|(o, &(k, a))| *o = a * col[k]),
+                // (W's columns are contiguous, as `dense::mat_mul` takes them)
+                let col = w.col(c).try_as_col_major().expect("contiguous column");
+                let col = col.as_slice();
+                for (o, &(k, a)) in dst.iter_mut().zip(&disp).filter(|(_, t)| t.1 != 0.0) {
+                    *o = a * col[k];
                 }
             }
             out
