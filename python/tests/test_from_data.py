@@ -82,6 +82,8 @@ class FromData:
         self.AL = sp.csr_matrix(self.A).astype(np.longdouble)
         self.NL = sp.csr_matrix(self.N).astype(np.longdouble)
         self.TL = sp.csr_matrix(self.T).astype(np.longdouble)
+        self.NtL = sp.csr_matrix(self.N.T).astype(np.longdouble)
+        self.TtL = sp.csr_matrix(self.T.T).astype(np.longdouble)
         self.row_sum = max(abs(self.N).sum(axis=1).max(), abs(self.T).sum(axis=1).max())
 
     def gaps(self, alpha, lam):
@@ -90,8 +92,7 @@ class FromData:
         f = self.f0 + self.phi(alpha) * self.f1
         ln = np.longdouble
         fl = (self.f0.astype(ln) + ln(self.phi(alpha)) * self.f1.astype(ln)
-              + sp.csr_matrix(self.N.T).astype(ln) @ lam[:p].astype(ln)
-              + sp.csr_matrix(self.T.T).astype(ln) @ lam[p:].astype(ln))
+              + self.NtL @ lam[:p].astype(ln) + self.TtL @ lam[p:].astype(ln))
         u = self.lu.solve(np.asarray(fl, dtype=np.float64)).astype(ln)
         for _ in range(3):
             u = u + self.lu.solve(np.asarray(fl - self.AL @ u, dtype=np.float64)).astype(ln)
