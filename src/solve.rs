@@ -18,7 +18,8 @@
 //!    from the all-stick piece.
 //! 5. Otherwise: [`crate::Error::SolveFailed`] saying what each stage reached.
 //!
-//! A returned `λ` always satisfies `‖H‖∞ ≤ 1e-12` relative to its force scale.
+//! A returned `λ` always satisfies `‖H‖∞ ≤ 1e-12` relative to its force scale, or is the
+//! caller's polish of a stalled iterate (see [`solve_fixed_alpha`]).
 
 use faer::MatRef;
 
@@ -473,14 +474,25 @@ fn block_gauss_seidel(
 
 /// Solves `H(λ, α) = 0` for `q − (g, 0)` given (2p values), from `guess` or zero forces.
 /// `alpha` is only used in messages.
+///
+/// `polish`, where given, is offered each stage's last iterate when the stage stalls; a
+/// point it returns is taken as the solution. The path passes one where W is carried
+/// beyond double: it solves the iterate's piece again in double-double until the classes
+/// settle (an exact solution of `H = 0` to that precision), which reaches solutions that
+/// no double iterate reaches on an ill-conditioned W (κ(W) = 2.7e12: every stage stalled
+/// at residuals of 1e-8 to 4e-11, also without friction).
 pub(crate) fn solve_fixed_alpha(
     problem: &crate::problem::Problem,
     qg: &[f64],
     guess: Option<&[f64]>,
     alpha: f64,
+    polish: Polish<'_>,
 ) -> Result<Vec<f64>> {
-    solve_with_frozen(problem, qg, guess, alpha, None, None)
+    solve_with_frozen(problem, qg, guess, alpha, None, None, polish)
 }
+
+/// See [`solve_fixed_alpha`]: a last chance for a stalled iterate.
+pub(crate) type Polish<'a> = Option<&'a mut dyn FnMut(&[f64]) -> Option<Vec<f64>>>;
 
 /// As [`solve_fixed_alpha`], with the classes of some nodes imposed, and the piece solves
 /// by updates of `seed` where given (a factorisation of a nearby piece: the path's, for
@@ -492,6 +504,7 @@ pub(crate) fn solve_with_frozen(
     alpha: f64,
     fr: Frozen<'_>,
     seed: Option<UpdatedLu>,
+    mut polish: Polish<'_>,
 ) -> Result<Vec<f64>> {
     let c = PieceConstants::of(problem);
     let w = problem.delassus().w();
@@ -500,6 +513,7 @@ pub(crate) fn solve_with_frozen(
     let mut pieces = PieceSolves::new(&c, w, w_row_sums, seed);
     let lam0 = guess.map(|g| g.to_vec()).unwrap_or_else(|| vec![0.0; m]);
     let mut notes = Vec::new();
+    let mut polished = |lam: &[f64]| polish.as_mut().and_then(|f| f(lam));
     let lam = match newton_active_newton(&mut pieces, qg, lam0, [20, 100, 200], fr) {
         Ok(lam) => return Ok(lam),
         Err((lam, msgs)) => {
@@ -507,6 +521,9 @@ pub(crate) fn solve_with_frozen(
             lam
         }
     };
+    if let Some(lam) = polished(&lam) {
+        return Ok(lam);
+    }
     // Newton stalls where its merit function is not smooth (classes change): a few block
     // Gauss-Seidel sweeps move the iterate off such a kink, and Newton resumes from there.
     // Rounds of both before the long Gauss-Seidel run below (each sweep is O(m²)).
@@ -522,6 +539,9 @@ pub(crate) fn solve_with_frozen(
             notes.push(format!("after 20 rounds of 20 sweeps and Newton: {msg}"));
         }
     }
+    if let Some(lam) = polished(&lam) {
+        return Ok(lam);
+    }
     // The continuation in the friction coefficients before the long Gauss-Seidel run: on
     // a p = 1000 strip with F = 5, mid-load, Newton stalled at a residual of 1e-6 and
     // the active set cycled on the free end's node (slip ↔ open) in every round; the
@@ -534,6 +554,9 @@ pub(crate) fn solve_with_frozen(
     let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20_000, fr);
     let (lam, ok, msg) = newton(&mut pieces, qg, lam_gs, 200, fr);
     if ok {
+        return Ok(lam);
+    }
+    if let Some(lam) = polished(&lam) {
         return Ok(lam);
     }
     notes.push(format!("after block Gauss-Seidel: {msg}"));

@@ -476,7 +476,9 @@ class Problem:
 
         ``alpha_start`` (default ``window[0]``) is where the fixed-alpha solve starts the
         path; it then goes toward ``window[1]``, through folds, until alpha leaves the
-        window. Where that solve fails at ``alpha_start``, it solves at a nearby alpha
+        window. Where W is carried in extended precision, a stage of that solve that
+        stalls has its last iterate solved again on its piece in double-double until the
+        classes settle. Where that solve fails at ``alpha_start``, it solves at a nearby alpha
         (1e-3, 1e-2, 1e-1 of the window's length away, or of a thousand times the load's
         own alpha scale ||q|| / ||q'|| where that is shorter; inside the window) and the path
         from there is traced back to ``alpha_start``: the point it reaches is the start

@@ -18,7 +18,7 @@ window's end point was an unchecked updated solve (an open node's λ at 1.8e-6 o
 scale), an 801 × 3 strip on 80 × 0.06 whose start began on a piece that does not contain
 the start point (1.6e-3 outside the stick cone), and a 101 × 5 strip whose queried points
 under a general load were solved in double though the problem is carried in extended
-precision.
+precision; and a 2001 × 3 strip whose start failed (below).
 """
 
 import os
@@ -49,6 +49,12 @@ RECTANGLES = {
         "--alpha-start", "0.0", "--alpha-end", "3.0",
         "--load0", "top:-0.00867,-0.01034:0.0084,-0.02619",
         "--load1", "top:0.00098,-0.0007:-0.00143,-0.00125",
+    ],
+    "strip-2001x3": [
+        "--nx", "2001", "--ny", "3", "--lx", "200.0", "--ly", "0.2", "--friction", "1",
+        "--alpha-start", "-2.0", "--alpha-end", "2.0",
+        "--load0", "top:0.00329,-0.01438:-0.00556,-0.01574",
+        "--load1", "top:0.00459,-0.00969:0.00354,0.00629", "--load1", "right:0.00504,-0.00359",
     ],
     "strip-101x5": [
         "--nx", "101", "--ny", "5", "--lx", "10.0", "--ly", "0.12", "--friction", "2",
@@ -200,3 +206,22 @@ def test_oscillating_loads_hold_from_the_data(kind, tmp_path):
         dload = (lambda a: dphi(a) * f1) if kind == "general with derivative" else None
         path = prob.trace(load=lambda a: f0 + phi(a) * f1, dload=dload, window=(a0, a1))
     assert_valid(case, path, phi, inside=True)
+
+
+def test_a_start_that_no_double_iterate_reaches_holds_from_the_data(tmp_path):
+    """The 2001 × 3 strip on 200 × 0.2 (F = 1, p = 2000, κ(W) = 2.7e12): at α = −2 and at
+    every nearby α tried, each stage of the fixed-α solver stalled at residuals of 1e-8 to
+    4e-11 (without friction too), and from α = −1.6 no piece was offered toward −2, so the
+    start failed after 7 minutes. In extended precision a stalled iterate is now solved
+    again on its piece in double-double until its classes settle. The start and the first
+    transitions from it (the trace is cut at 15) must hold from the data."""
+    case = generated("strip-2001x3", tmp_path)
+    prob = problem(case)
+    assert prob.extended_precision
+    path = prob.trace(case["f0"], case["f1"], window=(case["alpha_start"], case["alpha_end"]),
+                      max_steps=15)
+    assert path.end_reason == "max_steps", path.end_message
+    assert path.pieces[0].alpha_from == -2.0
+    (v, where), jump = worst_violation(case, path, lambda a: a)
+    assert v <= TOL, f"{v:.3e} at (piece, α, node, class, condition) = {where}"
+    assert jump <= 1e-9, f"consecutive pieces {jump:.3e} apart"

@@ -807,8 +807,10 @@ pub unsafe extern "C" fn fricont_path_set_monitor(
 /// with a line search; where that stalls, projected block Gauss–Seidel and a continuation
 /// in the friction coefficients), from the contact forces `guess` = (λν, λt) or, if
 /// `guess` is NULL, from zero forces. A restart clears the events and pieces traced so
-/// far. The load callbacks may be called. Where every stage of the solver fails at
-/// `alpha`, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the window's length away,
+/// far. The load callbacks may be called. Where W is carried beyond double precision, a
+/// stage that stalls has its last iterate solved again on its piece in double-double until
+/// the classes settle (an exact solution to that precision). Where every stage of the
+/// solver fails at `alpha`, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the window's length away,
 /// or of a thousand times the load's own α scale at `alpha` where that is shorter, the
 /// larger of `‖q‖∞ / ‖q'‖∞` and `|alpha − alpha_start|`; toward `alpha_end` first,
 /// inside the window) and traces the path from there back to `alpha`: the point it

@@ -366,8 +366,16 @@ impl Path {
     ) -> Option<Vec<Class>> {
         let qdir: Vec<f64> = pt.dq.iter().map(|v| s * v).collect();
         let seed = self.updater.borrow().clone();
-        let lam =
-            solve_with_frozen(&self.problem, &qdir, None, pt.alpha, Some(frozen), seed).ok()?;
+        let lam = solve_with_frozen(
+            &self.problem,
+            &qdir,
+            None,
+            pt.alpha,
+            Some(frozen),
+            seed,
+            None,
+        )
+        .ok()?;
         let w = self.problem.delassus().w();
         let d = displacement_gaps(w, &qdir, &lam);
         let r0 = self.problem.default_r();

@@ -386,6 +386,13 @@ const FAR_WINDOW: f64 = 1e3;
 /// a few nodes at most).
 const START_REFINE_ROUNDS: usize = 8;
 
+/// As [`START_REFINE_ROUNDS`], from a stalled iterate of the fixed-α solver (its classes
+/// differ from the solution's in tens of nodes): on a 2001 × 3 node strip (200 × 0.2,
+/// F = 1, κ(W) = 2.7e12) the classes changed in 51, 12, 9, 6, 3, 8, 6, 3, … nodes and
+/// settled after 17 pieces (2.4 s at p = 2000), where every stage of the solver stalled
+/// at residuals of 1e-8.
+const ITERATE_REFINE_ROUNDS: usize = 40;
+
 /// The per-row thresholds of displacement forms, computed on first use: row k costs one
 /// pass over row k of W (`(|W| |λ|)_k`), so a transition pays only for the rows it asks.
 #[derive(Debug)]
@@ -1625,6 +1632,10 @@ impl Path {
     /// start lies on a vertical piece (a continuum at this α), the path follows the way
     /// along it that leads toward `alpha_end` (tried by stepping along each; events met on
     /// the way are the path's own).
+    /// Where the problem is carried beyond double ([`Problem::extended_precision`]), a
+    /// stage of the fixed-α solver that stalls has its last iterate solved again on its
+    /// piece in double-double until the classes settle (an exact solution of `H = 0` to
+    /// that precision, reached where no double iterate reaches 1e-12 on an ill-conditioned W).
     /// Where the fixed-α solver fails at `alpha`, it solves at a nearby α instead (1e-3,
     /// 1e-2, 1e-1 of the window's length away, or of 1e3 times the load's own α scale at
     /// `alpha`, `max(‖q‖∞ / ‖q'‖∞, |alpha − alpha_start|)`, where that is shorter, toward
@@ -1742,7 +1753,21 @@ impl Path {
         let pt = self.point_at(vec![0.0; m], alpha)?;
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let guess = guess.map(|g| self.lam_to_internal(g));
-        let lam = solve_fixed_alpha(&self.problem, &qg, guess.as_deref(), alpha)?;
+        let problem = Arc::clone(&self.problem);
+        let lam = if problem.extended_precision() {
+            let at = pt.clone();
+            let mut polish = |lam: &[f64]| {
+                let iterate = Point {
+                    lam: lam.to_vec(),
+                    ..at.clone()
+                };
+                self.start_on_its_piece(&iterate, &qg, ITERATE_REFINE_ROUNDS)
+                    .map(|(lam, _)| lam)
+            };
+            solve_fixed_alpha(&problem, &qg, guess.as_deref(), alpha, Some(&mut polish))?
+        } else {
+            solve_fixed_alpha(&problem, &qg, guess.as_deref(), alpha, None)?
+        };
         let mut pt = Point { lam, ..pt };
         let mut tol = self.tol_at(&pt);
         let p = self.problem.p();
@@ -1760,7 +1785,7 @@ impl Path {
         // always solved again on its piece from the data, in double-double, until its
         // classes are those of the refined point.
         let mut refined_classes = None;
-        if let Some((lam, classes)) = self.start_on_its_piece(&pt, &qg) {
+        if let Some((lam, classes)) = self.start_on_its_piece(&pt, &qg, START_REFINE_ROUNDS) {
             pt.lam = lam;
             tol = self.tol_at(&pt);
             all = self.compatible(&every, &pt, &tol);
@@ -1791,22 +1816,32 @@ impl Path {
         // node's small dt count as zero: the path began to stick there, on a piece that
         // lies 1.6e-3 of max|λ| away (its cone crossed by that), and the node's own
         // transition, slip to stick 5.7e-4 further in α, was never reported. Where no
-        // candidate passes, the refined point's own piece leaves it (it is interior).
-        if self.problem.extended_precision() && !toward.is_empty() {
+        // candidate passes, or none leaves toward alpha_end at all, the refined point's
+        // own piece leaves it where it is interior: the thresholds of double took an open
+        // node whose refined gap was 1e-11, 20 times below its threshold, for one at
+        // zero, and offered only the piece leaving the other way (a 2001 × 3 node strip,
+        // κ(W) = 2.7e12, started at α = −1.6 toward −2).
+        if self.problem.extended_precision() {
+            let offered = !toward.is_empty();
             toward.retain(|&k| self.passes_through(&pt, &cands[k]));
             if toward.is_empty() {
                 let interior = refined_classes
                     .as_deref()
                     .and_then(|classes| self.interior_candidate(&pt, classes, want));
-                let Some(cand) = interior else {
-                    return Err(Error::Numerical(format!(
-                        "no piece leaves the start point alpha = {alpha} toward alpha_end = {} \
-                         in double-double (each candidate of double precision lies off it)",
-                        self.opts.alpha_end
-                    )));
-                };
-                cands = vec![cand];
-                toward = vec![0];
+                match interior {
+                    Some(cand) => {
+                        cands = vec![cand];
+                        toward = vec![0];
+                    }
+                    None if offered => {
+                        return Err(Error::Numerical(format!(
+                            "no piece leaves the start point alpha = {alpha} toward alpha_end = {} \
+                             in double-double (each candidate of double precision lies off it)",
+                            self.opts.alpha_end
+                        )));
+                    }
+                    None => {}
+                }
             }
         }
         if let Some(&k) = toward.first() {
@@ -1866,19 +1901,34 @@ impl Path {
     /// [`START_REFINE_ROUNDS`] pieces: an active-set iteration in double-double); its d
     /// kept for [`Self::gaps`]. None in double, on a vertical piece, or when a refinement
     /// fails or the classes do not settle.
-    fn start_on_its_piece(&mut self, pt: &Point, qg: &[f64]) -> Option<(Vec<f64>, Vec<Class>)> {
+    fn start_on_its_piece(
+        &mut self,
+        pt: &Point,
+        qg: &[f64],
+        rounds: usize,
+    ) -> Option<(Vec<f64>, Vec<Class>)> {
         if !self.problem.extended_precision() {
             return None;
         }
         let mut cur = pt.clone();
         let mut d = crate::piece::displacement_gaps(self.problem.delassus().w(), qg, &pt.lam);
         let mut classes = crate::solve::active_classes(&self.consts(), &cur.lam, &d, None);
-        for _ in 0..START_REFINE_ROUNDS {
+        for _ in 0..rounds {
             let piece = self.tangent(&classes, &cur, self.force_scale(&cur))?;
             if piece.scales.is_vertical(&piece.t) {
                 return None;
             }
-            let (lam, d_new) = self.polish_point(&classes, &piece.lu, cur.alpha, &cur.lam)?;
+            // From a point far from the piece's solution (a stalled iterate of the
+            // fixed-α solver) the refinement's first correction is too large to trust: it
+            // starts again from the piece's own solution in double.
+            let polished = self
+                .polish_point(&classes, &piece.lu, cur.alpha, &cur.lam)
+                .or_else(|| {
+                    let rhs = self.consts().piece_rhs(&classes, qg);
+                    let (x, _) = self.piece_solve(&classes, piece.lu.updated(), &rhs);
+                    self.polish_point(&classes, &piece.lu, cur.alpha, &x)
+                });
+            let (lam, d_new) = polished?;
             (cur.lam, d) = (lam, d_new);
             let next = crate::solve::active_classes(&self.consts(), &cur.lam, &d, None);
             if next == classes {
