@@ -214,14 +214,18 @@ def test_a_start_that_no_double_iterate_reaches_holds_from_the_data(tmp_path):
     4e-11 (without friction too), and from α = −1.6 no piece was offered toward −2, so the
     start failed after 7 minutes. In extended precision a stalled iterate is now solved
     again on its piece in double-double until its classes settle. The start and the first
-    transitions from it (the trace is cut at 15) must hold from the data."""
+    transitions from it (the trace is cut at 15) must hold from the data. So must the path
+    from α = −1.6 toward −2, where the solver converges but the thresholds of double took
+    the free end's open node (refined gap 1e-11, its threshold 2.2e-10) for one at zero and
+    offered only the piece leaving toward +α: the refined point's own piece leaves it."""
     case = generated("strip-2001x3", tmp_path)
     prob = problem(case)
     assert prob.extended_precision
-    path = prob.trace(case["f0"], case["f1"], window=(case["alpha_start"], case["alpha_end"]),
-                      max_steps=15)
-    assert path.end_reason == "max_steps", path.end_message
-    assert path.pieces[0].alpha_from == -2.0
-    (v, where), jump = worst_violation(case, path, lambda a: a)
-    assert v <= TOL, f"{v:.3e} at (piece, α, node, class, condition) = {where}"
-    assert jump <= 1e-9, f"consecutive pieces {jump:.3e} apart"
+    for window in [(-2.0, 2.0), (-1.6, -2.0)]:
+        path = prob.trace(case["f0"], case["f1"], window=window, max_steps=15)
+        assert path.end_reason == "max_steps", path.end_message
+        assert path.pieces[0].alpha_from == window[0]
+        assert (path.pieces[-1].alpha_to - window[0]) * (window[1] - window[0]) > 0
+        (v, where), jump = worst_violation(case, path, lambda a: a)
+        assert v <= TOL, f"{window}: {v:.3e} at (piece, α, node, class, condition) = {where}"
+        assert jump <= 1e-9, f"{window}: consecutive pieces {jump:.3e} apart"
