@@ -374,7 +374,9 @@ pub enum ExtendedPrecision {
     /// nnz(A))`) are at most [`AUTO_SMALL_FLOPS`] (2e8, about 0.05 s on one core), or the
     /// estimate [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e6) and
     /// they are at most `max(20 × the factorisation's, 1e11)` ([`AUTO_COST_FLOPS`]: about
-    /// 10 s on one core). A host's solve is never refined; condensed input counts as
+    /// 10 s on one core), or, whatever they cost, where the estimate exceeds
+    /// [`AUTO_CONDITION_ALWAYS`] (1e8: there double's rounding can move transition points
+    /// by 1e-3 and more). A host's solve is never refined; condensed input counts as
     /// extended when its W is ill-conditioned (the tracer then works in double-double
     /// with the caller's W).
     #[default]
@@ -395,6 +397,21 @@ pub enum ExtendedPrecision {
 /// α, at κ ≈ 1.4e6 the start by 1.2e-9 relative; at κ ≈ 4e5 and 9.7e5 they were within
 /// 1e-10. (It was 1e7, which left those two in double.)
 pub const AUTO_CONDITION: f64 = 1e6;
+
+/// [`ExtendedPrecision::Auto`] refines W whatever the refinement costs where the estimate of
+/// its condition number exceeds this. Double's rounding of W moves the solutions by about
+/// κ ε relative (1e-8 here), and a transition point by that divided by how steeply its
+/// guard crosses zero, which is not bounded: on a 2001 × 21-node strip on 200 × 0.6
+/// (F = 0.1, p = 2000, n = 84,000, estimate 6.4e10; its refinement 4.7e11 flops, over the
+/// budget below) the first transition in double lay 4.3e-3 in α (610 κ ε) from the
+/// refined one, whose path holds from the data to 3.5e-8 (SuperLU with long-double
+/// residuals); refined, that strip sets up in 71 s instead of 8 s and traces its window
+/// in 228 s instead of 38 s. On a 1001 × 21-node strip on 100 × 0.3 (estimate 3.0e10,
+/// 1.17e11 flops) the first transition in double was 1.1e-3 off the independent
+/// reference, refined 1.1e-9 (`cli/tests/slender.rs`). Below 1e8 the measured worst was
+/// 5 κ ε (a 2001 × 76-node strip, estimate 5.8e7: 3.1e-8 in α, refining it would cost
+/// 398 s of set-up instead of 11 s).
+pub const AUTO_CONDITION_ALWAYS: f64 = 1e8;
 
 /// [`ExtendedPrecision::Auto`] refines only when the refinement's estimated floating-point
 /// operations are at most `max(AUTO_COST_RATIO × the factorisation's, AUTO_COST_FLOPS)`.
@@ -707,8 +724,10 @@ impl ProblemBuilder {
                     ExtendedPrecision::Off => false,
                     ExtendedPrecision::Auto => {
                         let flops = del.refine_flops(full_a.nnz());
+                        let kappa = del.w_condition_estimate();
                         flops <= AUTO_SMALL_FLOPS
-                            || (del.w_condition_estimate() > AUTO_CONDITION
+                            || kappa > AUTO_CONDITION_ALWAYS
+                            || (kappa > AUTO_CONDITION
                                 && flops
                                     <= (AUTO_COST_RATIO * del.factor_flops()).max(AUTO_COST_FLOPS))
                     }

@@ -1195,9 +1195,11 @@ fn start_bifurcation_is_reported() {
 /// nodes on 6 × 0.1, W's condition estimate about 9e6): with `--extended-precision off`
 /// stderr says that W is ill-conditioned and traced in double, and the JSON's `precision`
 /// says the same; with `auto` (a small problem: refined) the note is the refinement's and
-/// `precision.extended` is true. The double events stay within the bound the note and
-/// docs/json-report.md state, 50 × condition × 1.1e-16 relative to max(1, |α|), of the
-/// refined ones (the same nodes and classes).
+/// `precision.extended` is true. The double events stay within 50 × condition × 1.1e-16
+/// relative to max(1, |α|) of the refined ones (the same nodes and classes): the note and
+/// docs/json-report.md say that W's rounding moves the solutions by condition × 1.1e-16
+/// and a transition point by that divided by how steeply its guard crosses zero, and this
+/// strip's guards cross steeply.
 #[test]
 fn ill_conditioned_w_in_double_is_reported() {
     let tmp = TempDir::new("illcond");

@@ -1163,3 +1163,69 @@ fn tracer_in_double_double_on_exact_condensed_data() {
         assert!(c.fricont.len() >= 50, "only {} events", c.fricont.len());
     }
 }
+
+/// `auto` refines W whatever the refinement costs where its condition estimate exceeds
+/// 1e8 (`fricont::problem::AUTO_CONDITION_ALWAYS`). This strip, 1001 × 21 nodes on
+/// 100 × 0.3 (F = 0.1, p = 1000, estimate 3.0e10), lies just over the cost budget
+/// (1.17e11 flops against 1e11), so `auto` traced it in double, where its first
+/// transition (the free end's node lifting off, a guard crossing zero at a shallow angle)
+/// came 1.1e-3 in α from the reference's: W's rounding moves the solutions by κ ε, and
+/// the crossing amplified that 330 times. Its first transitions must now agree with the
+/// independent reference (its own condensation in double-double: 94 s of this test).
+#[test]
+fn auto_refines_an_ill_conditioned_w_over_the_cost_budget() {
+    let spec = RectSpec {
+        nx: 1001,
+        ny: 21,
+        lx: 100.0,
+        ly: 0.3,
+        friction: 0.1,
+        gap: 0.0,
+        load0: vec![
+            Traction::linear(Side::Top, [0.00574, -0.01753], [0.00868, -0.0067]),
+            Traction::uniform(Side::Right, [0.00065, -0.00425]),
+        ],
+        load1: vec![Traction::linear(
+            Side::Top,
+            [0.00209, -0.00758],
+            [0.00123, 0.0099],
+        )],
+        alpha_start: 0.0,
+        alpha_end: 3.0,
+        ..RectSpec::press_shear()
+    };
+    let case = generate(&spec).expect("generate");
+    let problem = Arc::new(case.problem(None).expect("problem"));
+    assert!(
+        problem.extended_precision(),
+        "auto left W in double (estimate {:e})",
+        problem.w_condition_estimate()
+    );
+    let load = fricont::Load::affine(case.f0.clone(), case.f1.clone()).expect("load");
+    let mut path = fricont::Path::new(
+        problem,
+        load,
+        fricont::PathOptions::window(case.alpha_start, case.alpha_end),
+    )
+    .expect("path");
+    path.start(case.alpha_start, None).expect("start");
+    for _ in 0..3 {
+        path.step().expect("step");
+    }
+    let got: Vec<Ev> = path
+        .events()
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect();
+    let start = path.start_state().expect("start state");
+    let reference = condensed(&case).trace(
+        &start.classes,
+        case.alpha_start,
+        case.alpha_end,
+        3,
+        &mut no_progress(),
+    );
+    let want = ref_events(&reference);
+    assert_eq!(want.len(), 3, "reference: {:?}", reference.end);
+    compare_events(&got[..3], &want, 1e-8).unwrap_or_else(|e| panic!("{e}"));
+}

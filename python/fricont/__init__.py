@@ -358,7 +358,7 @@ class Problem:
         Cholesky factor of A; slender bodies, whose W is ill-conditioned). "auto" refines
         where that is cheap (small problems), or where W's condition estimate exceeds 1e6
         and the refinement costs at most about max(20 x the factorisation, 1e11
-        operations); see the properties ``extended_precision`` and
+        operations), or whatever it costs where the estimate exceeds 1e8; see the properties ``extended_precision`` and
         ``w_condition_estimate`` for what was chosen.
 
     Duplicate entries (a COO matrix, or a CSR matrix without canonical format) are summed,
@@ -416,9 +416,11 @@ class Problem:
         As the constructor's ``extended_precision`` says: "on" always, "off" never,
         "auto" (the default) small problems always, and problems whose W is
         ill-conditioned (``w_condition_estimate`` above 1e6) where the refinement costs at
-        most max(20 times the factorisation of A, 1e11) operations. When False, the rounding
-        of W moves transition points by up to about 50 * ``w_condition_estimate`` * 1.1e-16,
-        relative to max(1, abs(alpha)).
+        most max(20 times the factorisation of A, 1e11) operations, or whatever it costs
+        where the estimate exceeds 1e8. When False, the rounding of W moves the solutions by
+        about ``w_condition_estimate`` * 1.1e-16 relative, and a transition point by that
+        divided by how steeply its guard crosses zero (measured: up to 610 times that in
+        alpha, relative to max(1, abs(alpha)), on a slender strip of estimate 6.4e10).
         """
         return self._core.extended_precision
 
