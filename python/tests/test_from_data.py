@@ -18,7 +18,8 @@ window's end point was an unchecked updated solve (an open node's λ at 1.8e-6 o
 scale), an 801 × 3 strip on 80 × 0.06 whose start began on a piece that does not contain
 the start point (1.6e-3 outside the stick cone), and a 101 × 5 strip whose queried points
 under a general load were solved in double though the problem is carried in extended
-precision; and a 2001 × 3 strip whose start failed (below).
+precision; a 2001 × 3 strip whose start failed, and a 1201 × 11 strip that left its path at
+a fold (below).
 """
 
 import os
@@ -55,6 +56,12 @@ RECTANGLES = {
         "--alpha-start", "-2.0", "--alpha-end", "2.0",
         "--load0", "top:0.00329,-0.01438:-0.00556,-0.01574",
         "--load1", "top:0.00459,-0.00969:0.00354,0.00629", "--load1", "right:0.00504,-0.00359",
+    ],
+    "strip-1201x11": [
+        "--nx", "1201", "--ny", "11", "--lx", "120.0", "--ly", "0.3", "--friction", "5",
+        "--alpha-start", "-2.0", "--alpha-end", "2.0",
+        "--load0", "top:-0.00833,-0.00732:-0.00339,-0.00489", "--load0", "right:-0.00154,-0.00437",
+        "--load1", "top:-0.00249,-0.00526:-0.00781,0.0006",
     ],
     "strip-101x5": [
         "--nx", "101", "--ny", "5", "--lx", "10.0", "--ly", "0.12", "--friction", "2",
@@ -109,14 +116,16 @@ class FromData:
         return dn, dt, float(np.abs(u).max()), float(load_only)
 
 
-def worst_violation(case, path, phi, inside=False):
+def worst_violation(case, path, phi, inside=False, first_piece=0):
     """The largest violation of a class condition, relative to the path's scales, with
     where it is: (value, (piece, α, 1-based node, class, condition)); and the largest jump
-    between consecutive pieces relative to the force scale."""
+    between consecutive pieces relative to the force scale. Pieces from `first_piece` on."""
     data = FromData(case, phi)
     p = data.p
     pts = []
     for k, pc in enumerate(path.pieces):
+        if k < first_piece:
+            continue
         pts.append((k, pc.alpha_from, np.asarray(pc.lambda_from), pc.classes))
         pts.append((k, pc.alpha_to, np.asarray(pc.lambda_to), pc.classes))
         if inside and pc.alpha_to != pc.alpha_from:
@@ -156,7 +165,7 @@ def worst_violation(case, path, phi, inside=False):
                     worst = (v, (k, a, i + 1, c, what))
     jump = max((float(np.abs(np.asarray(path.pieces[k].lambda_to)
                                 - np.asarray(path.pieces[k + 1].lambda_from)).max()) / lam_scale
-                for k in range(len(path.pieces) - 1)), default=0.0)
+                for k in range(first_piece, len(path.pieces) - 1)), default=0.0)
     return worst, jump
 
 
@@ -229,3 +238,27 @@ def test_a_start_that_no_double_iterate_reaches_holds_from_the_data(tmp_path):
         (v, where), jump = worst_violation(case, path, lambda a: a)
         assert v <= TOL, f"{window}: {v:.3e} at (piece, α, node, class, condition) = {where}"
         assert jump <= 1e-9, f"{window}: consecutive pieces {jump:.3e} apart"
+
+
+def test_a_fold_where_widened_thresholds_offered_a_piece_off_the_point(tmp_path):
+    """The 1201 × 11 strip on 120 × 0.3 (F = 5, p = 1200, κ(W) ≈ 6e10, extended
+    precision): at transition 723 (α = −1.69053, a fold of node 426 next to node 427) two
+    pieces continued the path at the usual thresholds, and the thresholds widened to how
+    far the data determine q (κ(A) ε = 2.6e-4 of the load) offered a single other one,
+    node 426 sticking with a tangential displacement 100 times its usual threshold. That
+    piece did not contain the point (its own point lay 9e-5 outside its stick cone), and
+    the path stopped a transition later: "node 426 fits no class". A widened candidate
+    must now pass through the point in double-double. The pieces around the fold must hold
+    from the data (the whole window, 2405 events, held to 1.5e-10 when this was written).
+    """
+    case = generated("strip-1201x11", tmp_path)
+    prob = problem(case)
+    assert prob.extended_precision
+    path = prob.trace(case["f0"], case["f1"], window=(case["alpha_start"], case["alpha_end"]),
+                      max_steps=740)
+    assert path.end_reason == "max_steps", path.end_message
+    first = len(path.pieces) - 60
+    assert path.pieces[first].alpha_from < -1.6906 < -1.6904 < path.pieces[-1].alpha_to
+    (v, where), jump = worst_violation(case, path, lambda a: a, first_piece=first)
+    assert v <= TOL, f"{v:.3e} at (piece, α, node, class, condition) = {where}"
+    assert jump <= 1e-9, f"consecutive pieces {jump:.3e} apart"

@@ -539,6 +539,14 @@ impl Path {
         // the axis, lifting off, reached its stick cone 3.6e-11 of the forces before λ = 0
         // (its λt is rounding there), where slip in either direction continued the path: a
         // bifurcation, and the path stopped, where it lifts off.
+        //
+        // In extended precision a widened candidate must also contain the point: its own
+        // point at α, refined, must fit its classes to the widened thresholds. The
+        // thresholds widened to how far the data determine q (κ(A) ε = 2.6e-4 of the load
+        // on a 1201 × 11 strip on 120 × 0.3, F = 5) let a node at a fold whose dt was
+        // 100 times its usual threshold stick, where two continuations fitted the usual
+        // thresholds; that piece's own point lay 9e-5 outside its stick cone (forces of
+        // 1e-2), and the path went on along it until a node fitted no class.
         if cands.len() != 1 {
             let mut first = None;
             for widen in self.widening(&pt) {
@@ -555,6 +563,15 @@ impl Path {
                         unfit.get_or_insert(e);
                         continue;
                     }
+                };
+                let wider: Vec<Candidate> = if self.problem.extended_precision() {
+                    let tol = self.tol_at(&pt).widened(widen);
+                    wider
+                        .into_iter()
+                        .filter(|cd| self.passes_through_at(&pt, cd, &tol))
+                        .collect()
+                } else {
+                    wider
                 };
                 if wider.len() == 1 {
                     cands = wider;

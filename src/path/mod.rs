@@ -1983,15 +1983,20 @@ impl Path {
     /// precision, a vertical piece, a refinement that fails): [`Self::begin`] then keeps
     /// `pt` itself.
     fn passes_through(&mut self, pt: &Point, cand: &Candidate) -> bool {
+        let tol = self.tol_at(pt);
+        self.passes_through_at(pt, cand, &tol)
+    }
+
+    /// [`Self::passes_through`] to the thresholds `tol`.
+    fn passes_through_at(&mut self, pt: &Point, cand: &Candidate, tol: &Tol) -> bool {
         if cand.scales.is_vertical(&cand.t) {
             return true;
         }
         let Some((lam, d)) = self.polish_point(&cand.classes, &cand.lu, pt.alpha, &pt.lam) else {
             return true;
         };
-        let tol = self.tol_at(pt);
         (0..cand.classes.len()).all(|i| {
-            self.compatible_at(i, &lam, &d, &tol)
+            self.compatible_at(i, &lam, &d, tol)
                 .contains(&cand.classes[i])
         })
     }
