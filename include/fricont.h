@@ -996,9 +996,9 @@ fricont_status fricont_problem_set_threads(struct fricont_problem *problem,
  * of the 2-norm condition number of the equilibrated W exceeds 1e6 and the refinement's
  * estimated cost is at most max(20 × the factorisation's, 1e11 floating-point
  * operations), or whatever it costs where that estimate exceeds 1e8 (there double's
- * rounding moved a transition of a slender strip by 4.3e-3 in α); off never. A problem made from condensed data (`fricont_problem_new_condensed`)
- * is never refined (its W is the caller's data); with on (or auto and an ill-conditioned
- * W) it is traced in extended precision all the same. Like the friction, a change drops
+ * rounding moved a transition of a slender strip by 4.3e-3 in α); off never. A problem
+ * made from condensed data (`fricont_problem_new_condensed`) is never refined (its W is
+ * the caller's data); with on (or auto and an ill-conditioned W) it is traced in extended precision all the same. Like the friction, a change drops
  * the factorisation: the next build (explicit or by `fricont_path_new_*`) factorises A
  * again; existing paths are not affected. Query the outcome with
  * `fricont_problem_extended_precision`. Under a general load
@@ -1348,10 +1348,10 @@ fricont_status fricont_path_set_monitor(struct fricont_path *path,
  * far. The load callbacks may be called. Where W is carried beyond double precision, a
  * stage that stalls has its last iterate solved again on its piece in double-double until
  * the classes settle (an exact solution to that precision). Where every stage of the
- * solver fails at `alpha`, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the window's length away,
- * or of a thousand times the load's own α scale at `alpha` where that is shorter, the
- * larger of `‖q‖∞ / ‖q'‖∞` and `|alpha − alpha_start|`; toward `alpha_end` first,
- * inside the window) and traces the path from there back to `alpha`: the point it
+ * solver fails at `alpha`, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the
+ * window's length away, or of a thousand times the load's own α scale at `alpha` where
+ * that is shorter, the larger of `‖q‖∞ / ‖q'‖∞` and `|alpha − alpha_start|`; toward
+ * `alpha_end` first, inside the window) and traces the path from there back to `alpha`: the point it
  * reaches is the start (`FRICONT_ERR_SOLVE_FAILED` only where none leads there; the
  * message says what each reached).
  *
