@@ -1753,21 +1753,18 @@ impl Path {
         let pt = self.point_at(vec![0.0; m], alpha)?;
         let qg = shift_gap(&pt.q, self.problem.gap_equilibrated());
         let guess = guess.map(|g| self.lam_to_internal(g));
+        // (In double `start_on_its_piece` declines at once: no polish.)
         let problem = Arc::clone(&self.problem);
-        let lam = if problem.extended_precision() {
-            let at = pt.clone();
-            let mut polish = |lam: &[f64]| {
-                let iterate = Point {
-                    lam: lam.to_vec(),
-                    ..at.clone()
-                };
-                self.start_on_its_piece(&iterate, &qg, ITERATE_REFINE_ROUNDS)
-                    .map(|(lam, _)| lam)
+        let at = pt.clone();
+        let mut polish = |lam: &[f64]| {
+            let iterate = Point {
+                lam: lam.to_vec(),
+                ..at.clone()
             };
-            solve_fixed_alpha(&problem, &qg, guess.as_deref(), alpha, Some(&mut polish))?
-        } else {
-            solve_fixed_alpha(&problem, &qg, guess.as_deref(), alpha, None)?
+            self.start_on_its_piece(&iterate, &qg, ITERATE_REFINE_ROUNDS)
+                .map(|(lam, _)| lam)
         };
+        let lam = solve_fixed_alpha(&problem, &qg, guess.as_deref(), alpha, Some(&mut polish))?;
         let mut pt = Point { lam, ..pt };
         let mut tol = self.tol_at(&pt);
         let p = self.problem.p();
