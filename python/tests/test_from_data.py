@@ -169,12 +169,12 @@ def worst_violation(case, path, phi, inside=False, first_piece=0):
     return worst, jump
 
 
-def assert_valid(case, path, phi, inside=False):
-    assert path.end_reason == "window", path.end_message
+def assert_valid(case, path, phi, inside=False, end="window", first_piece=0, ctx=""):
+    assert path.end_reason == end, f"{ctx}{path.end_message}"
     assert len(path.events) > 0
-    (v, where), jump = worst_violation(case, path, phi, inside)
-    assert v <= TOL, f"{v:.3e} at (piece, α, node, class, condition) = {where}"
-    assert jump <= 1e-9, f"consecutive pieces {jump:.3e} apart"
+    (v, where), jump = worst_violation(case, path, phi, inside, first_piece)
+    assert v <= TOL, f"{ctx}{v:.3e} at (piece, α, node, class, condition) = {where}"
+    assert jump <= 1e-9, f"{ctx}consecutive pieces {jump:.3e} apart"
 
 
 def problem(case):
@@ -232,12 +232,9 @@ def test_a_start_that_no_double_iterate_reaches_holds_from_the_data(tmp_path):
     assert prob.extended_precision
     for window in [(-2.0, 2.0), (-1.6, -2.0)]:
         path = prob.trace(case["f0"], case["f1"], window=window, max_steps=15)
-        assert path.end_reason == "max_steps", path.end_message
         assert path.pieces[0].alpha_from == window[0]
         assert (path.pieces[-1].alpha_to - window[0]) * (window[1] - window[0]) > 0
-        (v, where), jump = worst_violation(case, path, lambda a: a)
-        assert v <= TOL, f"{window}: {v:.3e} at (piece, α, node, class, condition) = {where}"
-        assert jump <= 1e-9, f"{window}: consecutive pieces {jump:.3e} apart"
+        assert_valid(case, path, lambda a: a, end="max_steps", ctx=f"{window}: ")
 
 
 def test_a_fold_where_widened_thresholds_offered_a_piece_off_the_point(tmp_path):
@@ -256,9 +253,6 @@ def test_a_fold_where_widened_thresholds_offered_a_piece_off_the_point(tmp_path)
     assert prob.extended_precision
     path = prob.trace(case["f0"], case["f1"], window=(case["alpha_start"], case["alpha_end"]),
                       max_steps=740)
-    assert path.end_reason == "max_steps", path.end_message
     first = len(path.pieces) - 60
     assert path.pieces[first].alpha_from < -1.6906 < -1.6904 < path.pieces[-1].alpha_to
-    (v, where), jump = worst_violation(case, path, lambda a: a, first_piece=first)
-    assert v <= TOL, f"{v:.3e} at (piece, α, node, class, condition) = {where}"
-    assert jump <= 1e-9, f"consecutive pieces {jump:.3e} apart"
+    assert_valid(case, path, lambda a: a, end="max_steps", first_piece=first)
