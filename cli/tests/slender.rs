@@ -1229,3 +1229,73 @@ fn auto_refines_an_ill_conditioned_w_over_the_cost_budget() {
     assert_eq!(want.len(), 3, "reference: {:?}", reference.end);
     compare_events(&got[..3], &want, 1e-8).unwrap_or_else(|e| panic!("{e}"));
 }
+
+/// A basis load entering a steep piece after a fold (extended precision, auto): a
+/// 401 × 5 strip on (0, 40) × (0, 0.12) with F = 5 (κ(W) = 1e10), whose affine path (1627
+/// events over its window, every piece end valid from the data: SuperLU with long-double
+/// residuals, to 1.6e-10 of its scales) folds at α = 1.5359 onto a piece 4e-6 long whose
+/// M_S is nearly singular. The same load as a basis load with weights (1, α), and
+/// reparametrised by the increasing `φ(α) = α + A sin(ω α)` (events at `φ(α_k)` the
+/// affine ones), must give the affine events. Before, the basis load's march evaluated
+/// that piece as `Σ_j w_j y_j + y_g`, whose terms cancel where M_S is nearly singular:
+/// its entry lay 1e-4 of λ off the transition point, four guards negative there, and the
+/// path took the node it had just switched back at once, retraced its way and ended
+/// "closed_loop" after 99 events (a loud failure on a scaled copy of the problem).
+#[test]
+fn basis_load_entering_a_steep_piece_after_a_fold() {
+    let case = rect_case(
+        r#"{"nx": 401, "ny": 5, "lx": 40.0, "ly": 0.12, "friction": 5.0,
+            "load0": [{"side": "top", "start": [0.00284, -0.02839], "end": [-0.00918, -0.01348]}],
+            "load1": [{"side": "top", "start": [-0.00293, -0.00424], "end": [0.00754, 0.00933]}],
+            "alpha_start": -2.0, "alpha_end": 2.0}"#,
+    );
+    let problem = Arc::new(case.problem(None).expect("problem"));
+    assert!(problem.extended_precision());
+    let (a0, a1) = (case.alpha_start, case.alpha_end);
+    let affine = common::trace(problem.clone(), case.load().expect("load"), a0, a1);
+    assert_eq!(affine.end_reason().map(|r| r.name()), Some("window"));
+    let want: Vec<Ev> = affine
+        .events()
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect();
+    assert!(
+        affine.events().iter().filter(|e| e.fold).count() >= 10,
+        "the affine path folds"
+    );
+    for (amp, omega) in [(0.0, 0.0), (0.01, 3.0)] {
+        let phi = move |a: f64| a + amp * (omega * a).sin();
+        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+            w[0] = 1.0;
+            w[1] = phi(a);
+            dw[0] = 0.0;
+            dw[1] = 1.0 + amp * omega * (omega * a).cos();
+            Ok::<(), fricont::load::LoadFailure>(())
+        };
+        let load = fricont::Load::basis(vec![case.f0.clone(), case.f1.clone()], Box::new(weights))
+            .expect("basis load");
+        // the window in α whose image under φ is the affine window
+        let inv = |y: f64| {
+            let mut a = y;
+            for _ in 0..60 {
+                a -= (phi(a) - y) / (1.0 + amp * omega * (omega * a).cos());
+            }
+            a
+        };
+        let path = common::trace(problem.clone(), load, inv(a0), inv(a1));
+        let ctx = format!("basis load, A = {amp}, ω = {omega}");
+        assert_eq!(
+            path.end_reason().map(|r| r.name()),
+            Some("window"),
+            "{ctx}: {} events",
+            path.events().len()
+        );
+        let got: Vec<Ev> = path
+            .events()
+            .iter()
+            .map(|e| (phi(e.alpha), e.node, e.from, e.to))
+            .collect();
+        let worst = compare_events(&got, &want, 1e-9).unwrap_or_else(|e| panic!("{ctx}: {e}"));
+        eprintln!("{ctx}: {} events, worst {worst:e} in φ", got.len());
+    }
+}

@@ -751,6 +751,23 @@ impl Path {
         };
         let classes = cur.classes.clone();
         let basis = self.basis_solutions(cur);
+        // A basis load's points along the piece from its entry, the transition point
+        // (λ_e, d_e at α_e): `λ(α) = λ_e + Σ_j (w_j(α) − w_j(α_e)) y_j`, d likewise. The
+        // combination `Σ_j w_j y_j + y_g` itself cancels where the piece is nearly
+        // singular (its y_j large, λ small): on a slender strip (F = 5, κ(W) = 1e10) it
+        // put the entry of a steep piece 1e-4 of λ off the transition point, four guards
+        // negative there, and the path turned back onto the piece it came from.
+        // Relative to the entry the error is that of the weights' change since it.
+        let anchor = match &basis {
+            Some(_) => {
+                let at = self.point_at(cur.lam.clone(), cur.alpha)?;
+                let d_e = self.gaps(&at).to_vec();
+                self.load
+                    .weights_at(cur.alpha)
+                    .map(|(w, _)| (d_e, at.q, w.to_vec()))
+            }
+            None => None,
+        };
         // The guards at α: from the piece's basis solutions where there are some (O(J m)),
         // else from solves with M_S. `exact`: the point that ends the piece, checked
         // against the data (its combination kept where its residual is at rounding level,
@@ -760,7 +777,18 @@ impl Path {
             let (qg, dq) = (shift_gap(&at.q, this.problem.gap_equilibrated()), &at.dq);
             let [lam, d, mut t, rate] = match (&basis, this.load.weights_at(alpha)) {
                 (Some(bs), Some((w, dw))) => {
-                    let [lam, d, t, rate] = bs.at(w, dw, &qg, dq);
+                    let [lam, d, t, rate] = match &anchor {
+                        Some((d_e, q_e, w_e)) => {
+                            let d = d_e
+                                .iter()
+                                .zip(at.q.iter().zip(q_e))
+                                .map(|(v, (a, b))| v + (a - b))
+                                .collect();
+                            let c: Vec<f64> = w.iter().zip(w_e).map(|(a, b)| a - b).collect();
+                            bs.combine(cur.lam.clone(), d, &c, dw, dq)
+                        }
+                        None => bs.at(w, dw, &qg, dq),
+                    };
                     if !exact {
                         [lam, d, t, rate]
                     } else if let Some((lam, d)) = this.checked_point(cur, &qg, lam, bs.refined) {
