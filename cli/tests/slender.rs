@@ -1299,3 +1299,156 @@ fn basis_load_entering_a_steep_piece_after_a_fold() {
         eprintln!("{ctx}: {} events, worst {worst:e} in φ", got.len());
     }
 }
+
+/// `diag(m, m)`, the second block with its values times `s`.
+fn block_pair(m: &fricont::CsrMatrix, s: f64) -> fricont::CsrMatrix {
+    let (r, c) = (m.nrows(), m.ncols());
+    let mut t = Vec::with_capacity(2 * m.nnz());
+    for i in 0..r {
+        for (j, v) in m.row(i) {
+            t.push((i, j, v));
+            t.push((r + i, c + j, s * v));
+        }
+    }
+    fricont::CsrMatrix::from_triplets("pair", 2 * r, 2 * c, &t).expect("block pair")
+}
+
+/// A strip and its mirror image (T → −T: slip+ and slip− swap), decoupled, under the same
+/// load: the pair's solution set is the product of the strip's curves at equal α, so the
+/// pair switches the strip's node and its image at each of the strip's transition points,
+/// and at a fold of the strip (where its curve turns back in α) the pair's set crosses
+/// itself: the three ways back (either copy folding, or both) are a bifurcation, and the
+/// path stops there. The events up to it are the strip's, twice; following the branch where
+/// both copies fold, the pair goes on as the strip does, to its next fold. A 101 × 11 strip
+/// on 10 × 0.3 (F = 5, extended precision) touches down at its free end and folds at
+/// once. Before, the join widened its thresholds at that bifurcation to how far the data
+/// determine q (there 1.4e-4 of the displacements), found that both nodes could stick
+/// (their tangential displacement, the largest of any node, 1.5e-4), took that single
+/// piece and went on, the fold skipped.
+#[test]
+fn a_mirrored_pair_of_strips_stops_at_the_strips_fold_as_a_bifurcation() {
+    let case = rect_case(
+        r#"{"nx": 101, "ny": 11, "lx": 10.0, "ly": 0.3, "friction": 5.0,
+            "load0": [{"side": "top", "start": [0.00614, -0.01009], "end": [-0.00272, -0.02154]}],
+            "load1": [{"side": "top", "start": [-0.00296, 0.00894], "end": [-0.00082, -0.00254]},
+                      {"side": "right", "start": [0.00514, -0.00573], "end": [0.00514, -0.00573]}],
+            "alpha_start": -2.0, "alpha_end": 2.0}"#,
+    );
+    let (a0, a1) = (case.alpha_start, case.alpha_end);
+    let p = case.n_mat.nrows();
+    let single = common::trace(
+        Arc::new(case.problem(None).expect("problem")),
+        case.load().expect("load"),
+        a0,
+        a1,
+    );
+    let events = single.events();
+    let folds: Vec<usize> = (0..events.len()).filter(|&k| events[k].fold).collect();
+    assert!(folds.len() >= 2, "the strip folds: {folds:?}");
+    let flip = |c: Class| match c {
+        Class::SlipPlus => Class::SlipMinus,
+        Class::SlipMinus => Class::SlipPlus,
+        c => c,
+    };
+    let twice = |range: std::ops::Range<usize>| -> Vec<Ev> {
+        events[range]
+            .iter()
+            .flat_map(|e| {
+                [
+                    (e.alpha, e.node, e.from, e.to),
+                    (e.alpha, e.node + p, flip(e.from), flip(e.to)),
+                ]
+            })
+            .collect()
+    };
+    let twice_f = |v: &[f64]| [v, v].concat();
+    let problem = fricont::ProblemBuilder::new(
+        block_pair(&case.a, 1.0),
+        fricont::Storage::Full,
+        block_pair(&case.n_mat, 1.0),
+        block_pair(&case.t_mat, -1.0),
+    )
+    .friction_uniform(case.friction[0])
+    .build()
+    .expect("pair");
+    assert!(problem.extended_precision());
+    let load = fricont::Load::affine(twice_f(&case.f0), twice_f(&case.f1)).expect("load");
+    let mut pair = fricont::Path::new(
+        Arc::new(problem),
+        load,
+        fricont::PathOptions::window(a0, a1),
+    )
+    .expect("path");
+    pair.start(a0, None).expect("start");
+    // At each stop, a fold of the strip; the branch where both copies fold goes on.
+    let mut stops = 0;
+    loop {
+        let reason = pair.run().expect("run");
+        if reason.name() == "window" {
+            break;
+        }
+        assert_eq!(reason.name(), "bifurcation", "stop {stops}");
+        let n = pair.events().len();
+        assert!(
+            n.is_multiple_of(2) && n / 2 < events.len(),
+            "stop {stops}: {n} events"
+        );
+        let e = &events[n / 2];
+        assert!(e.fold, "stop {stops}: not at a fold of the strip");
+        let stop = pair.current().expect("the stop point").alpha;
+        assert!(
+            (stop - e.alpha).abs() <= 1e-10 * e.alpha.abs().max(1.0),
+            "stop {stops} at {stop}, the fold at {}",
+            e.alpha
+        );
+        // The three ways back: the strip's node and its image each before or after the
+        // fold's switch, not both before (the way the pair came), all the same way in α.
+        let (i, j) = (e.node, e.node + p);
+        let branches = pair.branches();
+        let mut ways: Vec<(Class, Class)> = branches
+            .iter()
+            .map(|b| (b.classes[i], b.classes[j]))
+            .collect();
+        ways.sort();
+        let mut want = vec![
+            (e.to, flip(e.from)),
+            (e.from, flip(e.to)),
+            (e.to, flip(e.to)),
+        ];
+        want.sort();
+        assert_eq!(ways, want, "stop {stops}: the branches");
+        let d0 = branches[0].direction;
+        assert!(
+            d0 != 0 && branches.iter().all(|b| b.direction == d0),
+            "stop {stops}"
+        );
+        let both = branches
+            .iter()
+            .position(|b| (b.classes[i], b.classes[j]) == (e.to, flip(e.to)))
+            .expect("both fold");
+        pair.choose_branch(both).expect("choose");
+        stops += 1;
+        assert!(stops <= folds.len(), "more stops than folds");
+    }
+    assert!(stops >= 1, "the pair never stopped at a fold");
+    let got: Vec<Ev> = pair
+        .events()
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect();
+    let worst = compare_events(&got, &twice(0..events.len()), 1e-10)
+        .unwrap_or_else(|e| panic!("the pair's events: {e}"));
+    // every fold of the strip is a bifurcation of the pair
+    for &k in &folds {
+        assert!(
+            pair.events()[2 * k].bifurcation,
+            "the fold at {}",
+            events[k].alpha
+        );
+    }
+    eprintln!(
+        "{} events, {stops} stops at {} folds, worst {worst:e}",
+        got.len(),
+        folds.len()
+    );
+}

@@ -548,6 +548,25 @@ impl Path {
         // thresholds; that piece's own point lay 9e-5 outside its stick cone (forces of
         // 1e-2), and the path went on along it until a node fitted no class.
         if cands.len() != 1 {
+            // Where the usual thresholds found several continuations, a widened one must
+            // fit the point to at most MAX_WIDENING times the usual thresholds (an open
+            // node's λt against F times that): widening resolves bifurcations that are
+            // rounding artefacts, not genuine ones. Two decoupled copies of a strip
+            // (F = 5, extended precision) meet a fold of the strip as a bifurcation of three
+            // pieces (the pair's solution set crosses itself there); the thresholds widened
+            // to how far the data determine q let a node touching down with a tangential
+            // displacement of 1.5e-4 (the largest of any node) stick, the single piece
+            // found so was taken, and the fold of each copy was skipped.
+            let several = if cands.len() > 1 {
+                let widest = Widen {
+                    k: MAX_WIDENING,
+                    cone: true,
+                    ..usual
+                };
+                Some(self.compatible(&nodes, &pt, &self.tol_at(&pt).widened(widest)))
+            } else {
+                None
+            };
             let mut first = None;
             for widen in self.widening(&pt) {
                 let wider = match self.continuations_either(
@@ -572,6 +591,18 @@ impl Path {
                         .collect()
                 } else {
                     wider
+                };
+                let wider: Vec<Candidate> = match &several {
+                    Some(fits) => wider
+                        .into_iter()
+                        .filter(|cd| {
+                            nodes
+                                .iter()
+                                .zip(fits)
+                                .all(|(&i, fit)| fit.contains(&cd.classes[i]))
+                        })
+                        .collect(),
+                    None => wider,
                 };
                 if wider.len() == 1 {
                     cands = wider;
