@@ -757,16 +757,19 @@ impl Path {
         // singular (its y_j large, λ small): on a slender strip (F = 5, κ(W) = 1e10) it
         // put the entry of a steep piece 1e-4 of λ off the transition point, four guards
         // negative there, and the path turned back onto the piece it came from.
-        // Relative to the entry the error is that of the weights' change since it.
+        // Relative to the entry the error is that of the weights' change since it. Not
+        // where the basis solutions were refined in double-double: their combination is
+        // then accurate, and the entry carries the rounding of its α (in a window far out
+        // on the α axis, α_e's ulp times the piece's slope: events drifted by 1.6e-8).
         let anchor = match &basis {
-            Some(_) => {
+            Some(bs) if !bs.refined => {
                 let at = self.point_at(cur.lam.clone(), cur.alpha)?;
                 let d_e = self.gaps(&at).to_vec();
                 self.load
                     .weights_at(cur.alpha)
                     .map(|(w, _)| (d_e, at.q, w.to_vec()))
             }
-            None => None,
+            _ => None,
         };
         // The guards at α: from the piece's basis solutions where there are some (O(J m)),
         // else from solves with M_S. `exact`: the point that ends the piece, checked
