@@ -35,6 +35,7 @@ raise a subclass of :class:`fricont.Error` (``NotPositiveDefinite`` is also a
 from __future__ import annotations
 
 import json
+import warnings
 from dataclasses import dataclass
 from typing import Any, Callable, Optional, Sequence, Tuple
 
@@ -55,6 +56,18 @@ class NotPositiveDefinite(_core.NotPositiveDefinite, ValueError):
     """A is not positive definite, or B = [N; T] is rank-deficient."""
 
 
+class PrecisionWarning(UserWarning):
+    """Issued by :class:`Problem` when ``extended_precision="auto"`` left an
+    ill-conditioned W in double (its condition estimate above 1e6, its refinement over the
+    cost budget): the rounding of W then moves the solutions by about the estimate times
+    1.1e-16 relative, and a transition point by that divided by how steeply its guard
+    crosses zero, which has no bound (on a mirror-symmetric pair of strips of estimate
+    4.9e6 in double, mirrored nodes switched 4.3e-8 apart in alpha, where they switch
+    together, and the path took pieces the refined one does not). Pass
+    ``extended_precision="on"`` to refine W (a longer set-up), or ``"off"`` to say that
+    double is meant (no warning)."""
+
+
 __all__ = [
     "Problem",
     "Path",
@@ -65,6 +78,7 @@ __all__ = [
     "read_case",
     "Error",
     "NotPositiveDefinite",
+    "PrecisionWarning",
     "SolveError",
     "LoadError",
     "NumericalError",
@@ -359,7 +373,9 @@ class Problem:
         where that is cheap (small problems), or where W's condition estimate exceeds 1e6
         and the refinement costs at most about max(20 x the factorisation, 1e11
         operations), or whatever it costs where the estimate exceeds 1e8; see the properties ``extended_precision`` and
-        ``w_condition_estimate`` for what was chosen.
+        ``w_condition_estimate`` for what was chosen. Where "auto" leaves W in double with
+        an estimate above 1e6 (the refinement over its budget), a
+        :class:`PrecisionWarning` says so.
 
     Duplicate entries (a COO matrix, or a CSR matrix without canonical format) are summed,
     as by every fricont interface (C, C++, Fortran, the CLI's Matrix Market files).
@@ -393,6 +409,22 @@ class Problem:
             )
         except Exception as err:  # noqa: BLE001
             raise _reraise(err) from None
+        kappa = self._core.w_condition_estimate
+        if (
+            str(extended_precision) == "auto"
+            and not self._core.extended_precision
+            and kappa > _core.AUTO_CONDITION
+        ):
+            warnings.warn(
+                PrecisionWarning(
+                    f"W is ill-conditioned (condition estimate {kappa:.1e}) and auto left it in "
+                    f"double (its refinement would cost more than the budget): its rounding "
+                    f"moves the solutions by about {kappa * 1.1e-16:.0e} relative, and a "
+                    "transition point by that divided by how steeply its guard crosses zero; "
+                    'extended_precision="on" refines W, "off" means double (no warning)'
+                ),
+                stacklevel=2,
+            )
 
     @property
     def n(self) -> int:

@@ -807,5 +807,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LoadError", py.get_type::<LoadError>())?;
     m.add("NumericalError", py.get_type::<NumericalError>())?;
     m.add("UsageError", py.get_type::<UsageError>())?;
+    // (the condition estimate above which "auto" refines W where that is affordable)
+    m.add("AUTO_CONDITION", fricont::problem::AUTO_CONDITION)?;
     Ok(())
 }

@@ -25,6 +25,7 @@ a fold (below).
 import os
 import pathlib
 import subprocess
+import warnings
 
 import numpy as np
 import pytest
@@ -62,6 +63,9 @@ RECTANGLES = {
         "--alpha-start", "-2.0", "--alpha-end", "2.0",
         "--load0", "top:-0.00833,-0.00732:-0.00339,-0.00489", "--load0", "right:-0.00154,-0.00437",
         "--load1", "top:-0.00249,-0.00526:-0.00781,0.0006",
+    ],
+    "strip-801x21": [
+        "--nx", "801", "--ny", "21", "--lx", "80.0", "--ly", "2.0", "--friction", "1",
     ],
     "strip-101x5": [
         "--nx", "101", "--ny", "5", "--lx", "10.0", "--ly", "0.12", "--friction", "2",
@@ -256,3 +260,24 @@ def test_a_fold_where_widened_thresholds_offered_a_piece_off_the_point(tmp_path)
     first = len(path.pieces) - 60
     assert path.pieces[first].alpha_from < -1.6906 < -1.6904 < path.pieces[-1].alpha_to
     assert_valid(case, path, lambda a: a, end="max_steps", first_piece=first)
+
+
+def test_auto_warns_where_it_leaves_an_ill_conditioned_w_in_double(tmp_path):
+    """An 801 × 21 strip on 80 × 2 (p = 800, n = 33,600): W's condition estimate is 7.8e7,
+    above auto's 1e6, and its refinement costs more than auto's budget, so W stays in
+    double, where its rounding can move transition points by more than their printed
+    digits: the constructor says so with a PrecisionWarning. Not with "off" (double is
+    what was asked for), nor where auto refines (the 101 × 5 strip, whose refinement is
+    cheap)."""
+    case = generated("strip-801x21", tmp_path)
+    args = (case["A"], case["N"], case["T"])
+    with pytest.warns(fricont.PrecisionWarning, match="ill-conditioned"):
+        prob = fricont.Problem(*args, friction=case["friction"])
+    assert not prob.extended_precision
+    assert prob.w_condition_estimate > 1e6
+    small = generated("strip-101x5", tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        off = fricont.Problem(*args, friction=case["friction"], extended_precision="off")
+        refined = problem(small)
+    assert not off.extended_precision and refined.extended_precision
