@@ -726,6 +726,22 @@ fn sine_loads_through_folds() {
     }
 }
 
+/// The basis load `f0 + φ(α) f1` of `case`: vectors f0, f1 with weights (1, φ(α)) and
+/// their derivatives (0, φ'(α)).
+fn basis_along(
+    case: &fricont_exchange::io::CaseData,
+    phi: impl Fn(f64) -> f64 + Send + 'static,
+    dphi: impl Fn(f64) -> f64 + Send + 'static,
+) -> fricont::Load {
+    let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+        w.copy_from_slice(&[1.0, phi(a)]);
+        dw.copy_from_slice(&[0.0, dphi(a)]);
+        Ok::<(), fricont::load::LoadFailure>(())
+    };
+    fricont::Load::basis(vec![case.f0.clone(), case.f1.clone()], Box::new(weights))
+        .expect("basis load")
+}
+
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.
 fn strip(p: usize) -> RectSpec {
     RectSpec {
@@ -833,16 +849,9 @@ fn strip_p240_basis_loads() {
         for (name, amp) in [("identity", 0.0), ("oscillation", amp)] {
             let ctx = format!("{name}, extended precision {precision}");
             let phi = move |a: f64| a + amp * (omega * (a - a0)).sin();
-            let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
-                w[0] = 1.0;
-                w[1] = phi(a);
-                dw[0] = 0.0;
-                dw[1] = 1.0 + amp * omega * (omega * (a - a0)).cos();
-                Ok::<(), fricont::load::LoadFailure>(())
-            };
-            let load =
-                fricont::Load::basis(vec![case.f0.clone(), case.f1.clone()], Box::new(weights))
-                    .expect("basis load");
+            let load = basis_along(&case, phi, move |a| {
+                1.0 + amp * omega * (omega * (a - a0)).cos()
+            });
             let opts = fricont::PathOptions::window(a0, a1);
             let mut path = fricont::Path::new(problem.clone(), load, opts).expect("path");
             path.start(a0, None).expect(&ctx);
@@ -1271,15 +1280,9 @@ fn basis_load_entering_a_steep_piece_after_a_fold() {
     for (amp, omega, shift) in [(0.0, 0.0, 0.0), (0.01, 3.0, 0.0), (0.0, 0.0, 1e4)] {
         // φ of α − shift (exact near the window: α and shift are within a factor 2)
         let phi = move |a: f64| (a - shift) + amp * (omega * (a - shift)).sin();
-        let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
-            w[0] = 1.0;
-            w[1] = phi(a);
-            dw[0] = 0.0;
-            dw[1] = 1.0 + amp * omega * (omega * (a - shift)).cos();
-            Ok::<(), fricont::load::LoadFailure>(())
-        };
-        let load = fricont::Load::basis(vec![case.f0.clone(), case.f1.clone()], Box::new(weights))
-            .expect("basis load");
+        let load = basis_along(&case, phi, move |a| {
+            1.0 + amp * omega * (omega * (a - shift)).cos()
+        });
         // the window in α whose image under φ is the affine window
         let inv = |y: f64| {
             let mut a = y;
