@@ -757,12 +757,15 @@ impl Path {
         // singular (its y_j large, λ small): on a slender strip (F = 5, κ(W) = 1e10) it
         // put the entry of a steep piece 1e-4 of λ off the transition point, four guards
         // negative there, and the path turned back onto the piece it came from.
-        // Relative to the entry the error is that of the weights' change since it. Not
-        // where the basis solutions were refined in double-double: their combination is
-        // then accurate, and the entry carries the rounding of its α (in a window far out
-        // on the α axis, α_e's ulp times the piece's slope: events drifted by 1.6e-8).
+        // Relative to the entry the error is that of the weights' change since it. Only
+        // in extended precision where the basis solutions could not be refined: refined,
+        // their combination is accurate, and the entry carries the rounding of its α (in
+        // a window far out on the α axis, α_e's ulp times the piece's slope: events
+        // drifted by 1.6e-8); in double the entry carries the rounding of the transition
+        // point's own solve, and a mirror-symmetric pair of strips (κ(W) = 1.6e5) stopped
+        // with a node fitting no class where the combination traces its window.
         let anchor = match &basis {
-            Some(bs) if !bs.refined => {
+            Some(bs) if !bs.refined && self.problem.extended_precision() => {
                 let at = self.point_at(cur.lam.clone(), cur.alpha)?;
                 let d_e = self.gaps(&at).to_vec();
                 self.load
