@@ -184,10 +184,30 @@ impl BasisSolutions {
         }
         [lam, d, dl, rate]
     }
+
+    /// [`Self::combine`] from the piece's point `from` (its q, λ, d), whose weights were
+    /// `w_from`: the point at `q = q(α)` and the weights `w`, `w'` there, `dq = q'(α)`.
+    fn starting_at(
+        &self,
+        (from, w_from): (&Entry, &[f64]),
+        q: &[f64],
+        (w, dw): (&[f64], &[f64]),
+        dq: &[f64],
+    ) -> [Vec<f64>; 4] {
+        let d = from
+            .d
+            .iter()
+            .zip(q.iter().zip(&from.q))
+            .map(|(v, (a, b))| v + (a - b))
+            .collect();
+        let c: Vec<f64> = w.iter().zip(w_from).map(|(a, b)| a - b).collect();
+        self.combine(from.lam.clone(), d, &c, dw, dq)
+    }
 }
 
-/// A general load's point at the entry of a graph piece (see [`Path::exit_graph`]):
-/// `q(α_e)`, λ and `d = W λ + q − (g, 0)` there.
+/// A point of a graph piece, its `q(α)`, λ and `d = W λ + q − (g, 0)`: a general load's
+/// at the piece's entry (see [`Path::exit_graph`]), or where a basis load's combinations
+/// start from ([`BasisSolutions::starting_at`]).
 #[derive(Clone)]
 struct Entry {
     q: Vec<f64>,
@@ -767,10 +787,15 @@ impl Path {
         let anchor = match &basis {
             Some(bs) if !bs.refined && self.problem.extended_precision() => {
                 let at = self.point_at(cur.lam.clone(), cur.alpha)?;
-                let d_e = self.gaps(&at).to_vec();
-                self.load
-                    .weights_at(cur.alpha)
-                    .map(|(w, _)| (d_e, at.q, w.to_vec()))
+                let d = self.gaps(&at).to_vec();
+                self.load.weights_at(cur.alpha).map(|(w, _)| {
+                    let entry = Entry {
+                        q: at.q,
+                        lam: at.lam,
+                        d,
+                    };
+                    (entry, w.to_vec())
+                })
             }
             _ => None,
         };
@@ -784,15 +809,7 @@ impl Path {
             let [lam, d, mut t, rate] = match (&basis, this.load.weights_at(alpha)) {
                 (Some(bs), Some((w, dw))) => {
                     let [lam, d, t, rate] = match &anchor {
-                        Some((d_e, q_e, w_e)) => {
-                            let d = d_e
-                                .iter()
-                                .zip(at.q.iter().zip(q_e))
-                                .map(|(v, (a, b))| v + (a - b))
-                                .collect();
-                            let c: Vec<f64> = w.iter().zip(w_e).map(|(a, b)| a - b).collect();
-                            bs.combine(cur.lam.clone(), d, &c, dw, dq)
-                        }
+                        Some((entry, w_e)) => bs.starting_at((entry, w_e), &at.q, (w, dw), dq),
                         None => bs.at(w, dw, &qg, dq),
                     };
                     if !exact {
@@ -1279,8 +1296,11 @@ impl Path {
                 && let Some((w_r, _)) = self.load.weights_at(root)
             {
                 let w_r = w_r.to_vec();
-                let (lam_r, q_r) = (pt.lam.clone(), pt.q.clone());
-                let d_r = self.gaps(&pt);
+                let root_pt = Entry {
+                    q: pt.q.clone(),
+                    lam: pt.lam.clone(),
+                    d: self.gaps(&pt).to_vec(),
+                };
                 let through = |this: &mut Self, x: f64| -> Result<(Point, Vec<GuardRow>)> {
                     let at = this.point_at(Vec::new(), x)?;
                     let Some((w, dw)) = this.load.weights_at(x) else {
@@ -1288,13 +1308,8 @@ impl Path {
                             "the basis load's weights at alpha = {x:e} are missing"
                         )));
                     };
-                    let d: Vec<f64> = d_r
-                        .iter()
-                        .zip(at.q.iter().zip(&q_r))
-                        .map(|(v, (a, b))| v + (a - b))
-                        .collect();
-                    let c: Vec<f64> = w.iter().zip(&w_r).map(|(a, b)| a - b).collect();
-                    let [lam, d, mut t, rate] = bs.combine(lam_r.clone(), d, &c, dw, &at.dq);
+                    let [lam, d, mut t, rate] =
+                        bs.starting_at((&root_pt, &w_r), &at.q, (w, dw), &at.dq);
                     t.push(1.0);
                     let table = this.guard_rows(&classes, &lam, &d, Some((&t, &rate)));
                     Ok((Point { lam, ..at }, table))

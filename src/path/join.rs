@@ -569,7 +569,7 @@ impl Path {
             };
             let mut first = None;
             for widen in self.widening(&pt) {
-                let wider = match self.continuations_either(
+                let mut wider = match self.continuations_either(
                     &pt,
                     &cur.classes,
                     &nodes,
@@ -583,27 +583,18 @@ impl Path {
                         continue;
                     }
                 };
-                let wider: Vec<Candidate> = if self.problem.extended_precision() {
+                if self.problem.extended_precision() {
                     let tol = self.tol_at(&pt).widened(widen);
-                    wider
-                        .into_iter()
-                        .filter(|cd| self.passes_through_at(&pt, cd, &tol))
-                        .collect()
-                } else {
-                    wider
-                };
-                let wider: Vec<Candidate> = match &several {
-                    Some(fits) => wider
-                        .into_iter()
-                        .filter(|cd| {
-                            nodes
-                                .iter()
-                                .zip(fits)
-                                .all(|(&i, fit)| fit.contains(&cd.classes[i]))
-                        })
-                        .collect(),
-                    None => wider,
-                };
+                    wider.retain(|cd| self.passes_through_at(&pt, cd, &tol));
+                }
+                if let Some(fits) = &several {
+                    wider.retain(|cd| {
+                        nodes
+                            .iter()
+                            .zip(fits)
+                            .all(|(&i, fit)| fit.contains(&cd.classes[i]))
+                    });
+                }
                 if wider.len() == 1 {
                     cands = wider;
                     break;

@@ -1755,11 +1755,10 @@ impl Path {
         let guess = guess.map(|g| self.lam_to_internal(g));
         // (In double `start_on_its_piece` declines at once: no polish.)
         let problem = Arc::clone(&self.problem);
-        let at = pt.clone();
         let mut polish = |lam: &[f64]| {
             let iterate = Point {
                 lam: lam.to_vec(),
-                ..at.clone()
+                ..pt.clone()
             };
             self.start_on_its_piece(&iterate, &qg, ITERATE_REFINE_ROUNDS)
                 .map(|(lam, _)| lam)
