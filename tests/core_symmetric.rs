@@ -19,8 +19,8 @@ use std::collections::BTreeSet;
 use std::sync::Arc;
 
 use common::{
-    Brute, Case, check_state, class_equations_hold, lambda_ev, lambda_of, samples, symmetric_case,
-    vclose,
+    Brute, Case, check_state, class_equations_hold, lambda_ev, lambda_of, mirror_class, samples,
+    symmetric_case, vclose,
 };
 use fricont::{Class, EndReason, Path, PathOptions, StepOutcome};
 
@@ -243,11 +243,6 @@ fn mirror_body(seed: u64) -> (Case, usize, String) {
 /// axis has its mirror image (node nx − i, the same α to 1e-9, S+ and S− swapped), and the
 /// centre node never enters slip. Returns the number of events off the axis.
 fn assert_mirrored(ctx: &str, ev: &[(f64, usize, Class, Class)], nx: usize) -> usize {
-    let mirror = |c: Class| match c {
-        Class::SlipPlus => Class::SlipMinus,
-        Class::SlipMinus => Class::SlipPlus,
-        c => c,
-    };
     let mut pairs = 0;
     for &(al, i, from, to) in ev {
         if 2 * i == nx {
@@ -260,7 +255,7 @@ fn assert_mirrored(ctx: &str, ev: &[(f64, usize, Class, Class)], nx: usize) -> u
         assert!(
             ev.iter().any(|&(b, j, f, t)| j == nx - i
                 && (b - al).abs() <= 1e-9 * al.abs().max(1.0)
-                && (f, t) == (mirror(from), mirror(to))),
+                && (f, t) == (mirror_class(from), mirror_class(to))),
             "{ctx}: node {} {from} -> {to} at α = {al} has no mirror image",
             i + 1
         );

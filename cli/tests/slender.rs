@@ -22,7 +22,9 @@ use std::sync::Arc;
 use common::reference::{
     Condensed, Ev, SparseRows, compare_events, compare_on_rounded, compare_with_fricont,
 };
-use common::{Brute, fe_case, fold_problem, mirror_pair, random_case, symmetric_case};
+use common::{
+    Brute, fe_case, fold_problem, mirror_class, mirror_pair, random_case, symmetric_case,
+};
 use fricont::Class;
 use fricont_exchange::generator::{RectSpec, Side, Traction, generate};
 
@@ -1354,18 +1356,18 @@ fn a_mirrored_pair_of_strips_stops_at_the_strips_fold_as_a_bifurcation() {
     let events = single.events();
     let folds: Vec<usize> = (0..events.len()).filter(|&k| events[k].fold).collect();
     assert!(folds.len() >= 2, "the strip folds: {folds:?}");
-    let flip = |c: Class| match c {
-        Class::SlipPlus => Class::SlipMinus,
-        Class::SlipMinus => Class::SlipPlus,
-        c => c,
-    };
     let twice = |range: std::ops::Range<usize>| -> Vec<Ev> {
         events[range]
             .iter()
             .flat_map(|e| {
                 [
                     (e.alpha, e.node, e.from, e.to),
-                    (e.alpha, e.node + p, flip(e.from), flip(e.to)),
+                    (
+                        e.alpha,
+                        e.node + p,
+                        mirror_class(e.from),
+                        mirror_class(e.to),
+                    ),
                 ]
             })
             .collect()
@@ -1420,9 +1422,9 @@ fn a_mirrored_pair_of_strips_stops_at_the_strips_fold_as_a_bifurcation() {
             .collect();
         ways.sort();
         let mut want = vec![
-            (e.to, flip(e.from)),
-            (e.from, flip(e.to)),
-            (e.to, flip(e.to)),
+            (e.to, mirror_class(e.from)),
+            (e.from, mirror_class(e.to)),
+            (e.to, mirror_class(e.to)),
         ];
         want.sort();
         assert_eq!(ways, want, "stop {stops}: the branches");
@@ -1433,7 +1435,7 @@ fn a_mirrored_pair_of_strips_stops_at_the_strips_fold_as_a_bifurcation() {
         );
         let both = branches
             .iter()
-            .position(|b| (b.classes[i], b.classes[j]) == (e.to, flip(e.to)))
+            .position(|b| (b.classes[i], b.classes[j]) == (e.to, mirror_class(e.to)))
             .expect("both fold");
         pair.choose_branch(both).expect("choose");
         stops += 1;

@@ -182,6 +182,16 @@ pub fn lambda_of(s: &State) -> DVector<f64> {
     )
 }
 
+/// The class a node's mirror image takes: slip+ and slip− swapped (a body mirrored about
+/// a vertical axis measures its tangential displacements the other way).
+pub fn mirror_class(c: Class) -> Class {
+    match c {
+        Class::SlipPlus => Class::SlipMinus,
+        Class::SlipMinus => Class::SlipPlus,
+        c => c,
+    }
+}
+
 /// `|a − b| ≤ tol · max(1, |a|, |b|)`.
 pub fn close(a: f64, b: f64, tol: f64) -> bool {
     (a - b).abs() <= tol * 1f64.max(a.abs()).max(b.abs())
