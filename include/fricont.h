@@ -998,9 +998,10 @@ fricont_status fricont_problem_set_threads(struct fricont_problem *problem,
  * operations), or whatever it costs where that estimate exceeds 1e8 (there double's
  * rounding moved a transition of a slender strip by 4.3e-3 in α); off never. A problem
  * made from condensed data (`fricont_problem_new_condensed`) is never refined (its W is
- * the caller's data); with on (or auto and an ill-conditioned W) it is traced in extended precision all the same. Like the friction, a change drops
- * the factorisation: the next build (explicit or by `fricont_path_new_*`) factorises A
- * again; existing paths are not affected. Query the outcome with
+ * the caller's data); with on (or auto and an ill-conditioned W) it is traced in
+ * extended precision all the same. Like the friction, a change drops the factorisation:
+ * the next build (explicit or by `fricont_path_new_*`) factorises A again; existing
+ * paths are not affected. Query the outcome with
  * `fricont_problem_extended_precision`. Under a general load
  * (`fricont_path_new_general`) each evaluation is refined too, at about twice its cost:
  * in double alone the solutions at neighbouring α of a slender body disagree by more
@@ -1351,9 +1352,9 @@ fricont_status fricont_path_set_monitor(struct fricont_path *path,
  * solver fails at `alpha`, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the
  * window's length away, or of a thousand times the load's own α scale at `alpha` where
  * that is shorter, the larger of `‖q‖∞ / ‖q'‖∞` and `|alpha − alpha_start|`; toward
- * `alpha_end` first, inside the window) and traces the path from there back to `alpha`: the point it
- * reaches is the start (`FRICONT_ERR_SOLVE_FAILED` only where none leads there; the
- * message says what each reached).
+ * `alpha_end` first, inside the window) and traces the path from there back to `alpha`:
+ * the point it reaches is the start (`FRICONT_ERR_SOLVE_FAILED` only where none leads
+ * there; the message says what each reached).
  *
  * The problem at one α can have several solutions (large friction, a path that folds
  * back over `alpha`); the solver returns one of them, and which one can depend on

@@ -372,10 +372,10 @@ class Problem:
         Cholesky factor of A; slender bodies, whose W is ill-conditioned). "auto" refines
         where that is cheap (small problems), or where W's condition estimate exceeds 1e6
         and the refinement costs at most about max(20 x the factorisation, 1e11
-        operations), or whatever it costs where the estimate exceeds 1e8; see the properties ``extended_precision`` and
-        ``w_condition_estimate`` for what was chosen. Where "auto" leaves W in double with
-        an estimate above 1e6 (the refinement over its budget), a
-        :class:`PrecisionWarning` says so.
+        operations), or whatever it costs where the estimate exceeds 1e8; see the
+        properties ``extended_precision`` and ``w_condition_estimate`` for what was chosen.
+        Where "auto" leaves W in double with an estimate above 1e6 (the refinement over its
+        budget), a :class:`PrecisionWarning` says so.
 
     Duplicate entries (a COO matrix, or a CSR matrix without canonical format) are summed,
     as by every fricont interface (C, C++, Fortran, the CLI's Matrix Market files).

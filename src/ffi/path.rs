@@ -813,9 +813,9 @@ pub unsafe extern "C" fn fricont_path_set_monitor(
 /// solver fails at `alpha`, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the
 /// window's length away, or of a thousand times the load's own α scale at `alpha` where
 /// that is shorter, the larger of `‖q‖∞ / ‖q'‖∞` and `|alpha − alpha_start|`; toward
-/// `alpha_end` first, inside the window) and traces the path from there back to `alpha`: the point it
-/// reaches is the start (`FRICONT_ERR_SOLVE_FAILED` only where none leads there; the
-/// message says what each reached).
+/// `alpha_end` first, inside the window) and traces the path from there back to `alpha`:
+/// the point it reaches is the start (`FRICONT_ERR_SOLVE_FAILED` only where none leads
+/// there; the message says what each reached).
 ///
 /// The problem at one α can have several solutions (large friction, a path that folds
 /// back over `alpha`); the solver returns one of them, and which one can depend on
