@@ -6,6 +6,7 @@
 //! FRICONT_BENCH_CASE=DIR FRICONT_BENCH_REPS=15 cargo bench --bench trace
 //! FRICONT_BENCH_LOAD=basis-sine cargo bench --bench trace -- DIR
 //! FRICONT_BENCH_THREADS=2 cargo bench --bench trace -- DIR
+//! FRICONT_BENCH_REPS=1 FRICONT_BENCH_TRACES=20 cargo bench --bench trace -- DIR  # to profile
 //! FRICONT_BENCH_LOAD=general-sine FRICONT_BENCH_AMP=0.05 cargo bench --bench trace -- DIR
 //! ```
 //!
@@ -24,7 +25,8 @@
 //! binding the load (condensed load vectors). Trace = the start solve plus every step to
 //! the end of the window, on a fresh path over the same problem. Reading the files is
 //! timed apart and counted in neither. Each is repeated (default 7 times) and the median
-//! and minimum are printed, with the ratio trace/set-up of the medians (SPEC §6 wants it
+//! and minimum are printed (`FRICONT_BENCH_TRACES=k`: k traces after each set-up, all
+//! counted in the trace's median), with the ratio trace/set-up of the medians (SPEC §6 wants it
 //! below 1 for the sample).
 
 use std::path::PathBuf;
@@ -118,6 +120,12 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1);
+    // Traces per set-up (default 1); more make a profile of the trace alone.
+    let traces: usize = std::env::var("FRICONT_BENCH_TRACES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .filter(|&k| k > 0)
+        .unwrap_or(1);
     let mut setup = Vec::with_capacity(reps);
     let mut trace = Vec::with_capacity(reps);
     let mut start = Vec::with_capacity(reps);
@@ -129,21 +137,23 @@ fn main() {
         setup.push(t.elapsed().as_secs_f64());
         drop(path);
 
-        // A fresh path on the same problem: binding the load is set-up, not trace.
-        let mut path = Path::new(problem, load(), opts.clone()).expect("path");
-        let t = Instant::now();
-        path.start(opts.alpha_start, None).expect("start");
-        start.push(t.elapsed().as_secs_f64());
-        let end = path.run().expect("run");
-        trace.push(t.elapsed().as_secs_f64());
-        std::hint::black_box(path.events().len());
-        summary = format!(
-            "{} events, {} pieces, {} refactorisations, end: {}",
-            path.events().len(),
-            path.pieces().len(),
-            path.refactorisations(),
-            end.name()
-        );
+        for _ in 0..traces {
+            // A fresh path on the same problem: binding the load is set-up, not trace.
+            let mut path = Path::new(Arc::clone(&problem), load(), opts.clone()).expect("path");
+            let t = Instant::now();
+            path.start(opts.alpha_start, None).expect("start");
+            start.push(t.elapsed().as_secs_f64());
+            let end = path.run().expect("run");
+            trace.push(t.elapsed().as_secs_f64());
+            std::hint::black_box(path.events().len());
+            summary = format!(
+                "{} events, {} pieces, {} refactorisations, end: {}",
+                path.events().len(),
+                path.pieces().len(),
+                path.refactorisations(),
+                end.name()
+            );
+        }
     }
     let (s_med, s_min) = median_min(&mut setup);
     let (t_med, t_min) = median_min(&mut trace);
