@@ -26,9 +26,6 @@ use crate::piece::LinForm;
 /// Most refinement rounds of one solve (a piece whose rounds contract by 1e-2 each
 /// needed 11 from a first correction of 4.5e-4 of the solution).
 const MAX_ROUNDS: usize = 16;
-/// A first round whose correction is within this fraction of the solution ends the
-/// refinement (see [`Refiner::refine_all`]).
-const FIRST_ROUND: f64 = 1e-4;
 /// A correction this small relative to the solution's scale (max|x| or the data's force
 /// scale, see [`Refiner::refine_all`]) ends the refinement.
 const CONVERGED: f64 = 1e-24;
@@ -196,8 +193,8 @@ impl Refiner<'_> {
     /// that error: measured against max|x|, the first correction (5.7e-8 against a guess
     /// of 5.7e-8, under a general load on a slender strip, F = 5) failed the refinement,
     /// the march kept the double-precision points, and the lift-off came 1.1e-8 in α
-    /// early. Only the first round's test ([`FIRST_ROUND`]), whose correction stands for
-    /// what is left after it, stays relative to max|x| (a tiny x then takes more rounds).
+    /// early. Only the first round's test, whose correction stands for the contraction,
+    /// stays relative to max|x| (a tiny x then takes more rounds).
     fn refine_all(&self, pairs: Vec<(DdVec, DdVec)>) -> Option<Vec<(DdVec, DdVec)>> {
         let floors: Vec<f64> = pairs.iter().map(|(_, c)| self.floor(c)).collect();
         let refs: Vec<(&DdVec, &DdVec)> = pairs.iter().map(|(x, c)| (x, c)).collect();
@@ -251,20 +248,25 @@ impl Refiner<'_> {
                 }
                 // Converged when this correction, or the next one predicted from the
                 // contraction so far (step² / last), is below the target. After the first
-                // round there is no contraction to predict from. Taking every first round
-                // as enough (last = ∞ predicted 0), a rate dλ/dα on a slender strip (200 × 4
-                // elements on 10 × 0.1, F = 5) corrected by 4.5e-4 of itself, on a piece
-                // whose rounds contract by 1e-2 each, kept 4.3e-6 of error, and its exit
-                // was 4.7e-9 in α off the independent reference. So a first round is enough
-                // only where its correction is within FIRST_ROUND of the solution; else the
-                // rounds go on. (On the p = 960 strip of the benchmark, κ(W) = 2.4e10, the
-                // first corrections of most rates lie between 1e-6 and 1e-4 of them: going
-                // on from 1e-6 took 4 rounds each, changed no event by more than 2e-12 in
-                // α and made the trace 35 % slower.)
+                // round the contraction is taken to be that round's correction relative to
+                // the solution (a double-precision solve is off by about cond · ε of it, and
+                // each round contracts by about cond · ε), so a first round ends the
+                // refinement only where the correction is within about √CONVERGED (1e-12)
+                // of the solution. It used to end it where the correction was within 1e-4:
+                // on two stacked blocks (p = 640, F = 0.3, κ(W) = 2.3e7) a rate corrected
+                // by 5.7e-7 of itself in one round kept enough error to move the slope of a
+                // guard that is a small difference of large terms (a node's tangential
+                // displacement, 3.3e-6 per unit α against displacements of 1.4), and the
+                // exit at the end of that piece lay up to 3.1e-7 in α off where copies of
+                // the problem with rows scaled by other factors put it (double alone:
+                // 5e-10). With a second round every copy agrees to the last bit. (Before,
+                // taking every first round as enough, a rate corrected by 4.5e-4 of itself
+                // on a slender strip kept 4.3e-6 of error and its exit was 4.7e-9 in α off
+                // the independent reference.)
                 let predicted = if last[j].is_finite() {
                     step * (step / last[j]) <= CONVERGED * scale
                 } else {
-                    step <= FIRST_ROUND * size
+                    step * (step / size) <= CONVERGED * scale
                 };
                 if step <= CONVERGED * scale || predicted {
                     done[j] = true;
