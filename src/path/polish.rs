@@ -249,10 +249,10 @@ impl Refiner<'_> {
                 // Converged when this correction, or the next one predicted from the
                 // contraction so far (step² / last), is below the target. After the first
                 // round the contraction is taken to be that round's correction relative to
-                // the solution (a double-precision solve is off by about cond · ε of it, and
-                // each round contracts by about cond · ε), so a first round ends the
-                // refinement only where the correction is within about √CONVERGED (1e-12)
-                // of the solution. It used to end it where the correction was within 1e-4:
+                // the solution, step² / size (a double-precision solve is off by about
+                // cond · ε of it, and each round contracts by about cond · ε), so a first
+                // round ends the refinement only where the correction is within about
+                // √CONVERGED (1e-12) of the solution. It used to end it where the correction was within 1e-4:
                 // on two stacked blocks (p = 640, F = 0.3, κ(W) = 2.3e7) a rate corrected
                 // by 5.7e-7 of itself in one round kept enough error to move the slope of a
                 // guard that is a small difference of large terms (a node's tangential
@@ -263,11 +263,8 @@ impl Refiner<'_> {
                 // taking every first round as enough, a rate corrected by 4.5e-4 of itself
                 // on a slender strip kept 4.3e-6 of error and its exit was 4.7e-9 in α off
                 // the independent reference.)
-                let predicted = if last[j].is_finite() {
-                    step * (step / last[j]) <= CONVERGED * scale
-                } else {
-                    step * (step / size) <= CONVERGED * scale
-                };
+                let before = if last[j].is_finite() { last[j] } else { size };
+                let predicted = step * (step / before) <= CONVERGED * scale;
                 if step <= CONVERGED * scale || predicted {
                     done[j] = true;
                 } else if step > 0.5 * last[j] {
