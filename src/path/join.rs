@@ -424,7 +424,7 @@ impl Path {
         nodes.sort_unstable();
         nodes.dedup();
         let entry = self.point_at(cur.lam.clone(), cur.alpha)?;
-        let pt = self.snap_to_vertex(pt, &tol, &entry)?;
+        let pt = self.snap_to_vertex(pt, &tol, &entry, &cur.classes, &crossing)?;
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
         let usual = Widen::USUAL;
         let mut blockers = Vec::new();
@@ -669,15 +669,37 @@ impl Path {
         }
     }
 
-    /// At a point where every node is at the vertex (`λ = 0`, `q(α) = (g, 0)`: the load
-    /// passes through the state of zero contact forces), the exit point found from one
-    /// guard carries that guard's rounding; the exact point is `λ = 0` at the α that
-    /// minimises `‖q(α) − (g, 0)‖` (closed form for an affine load). Other points are
-    /// returned unchanged. "At the vertex" is judged against the forces along the piece
-    /// the path came by (`entry`: the point where it entered it), not against the point's
-    /// own: there the forces are rounding noise of the piece's solves, as large as
+    /// At a point where every contact force vanishes (the load passes through a state of
+    /// zero contact forces), the exit point found from one guard carries that guard's
+    /// rounding, relative to the magnitudes along the piece; where those vanish too (a
+    /// load proportional to α at α = 0) every threshold at the point is far below that
+    /// rounding. The exact point is `λ = 0` at the α where the load reaches that state:
+    /// - where every node is at the vertex (`q(α) = (g, 0)`), the α that minimises
+    ///   `‖q(α) − (g, 0)‖` (closed form for an affine load; the point's α otherwise);
+    /// - under an affine load, where the nodes open on the piece (`classes`) keep their
+    ///   gaps: the α that minimises it on the rows the piece holds at zero (both rows of
+    ///   a sticking node, the normal row of a slipping one), or, where the piece has no
+    ///   node in contact, the root of the crossing guard's gap, `q_k(α) = g_k`. A curved
+    ///   body touching the foundation at one node with zero gap (the apex) under a load
+    ///   proportional to α has that node alone at the vertex at α = 0: unloaded through
+    ///   it, the node's λt (rounding of the piece's solves, relative to the forces at the
+    ///   piece's entry) fitted no class at the point's thresholds, which are relative to
+    ///   a load of size 0; loaded through it from above, the touchdown's gap came out as
+    ///   α's rounding times q', above those thresholds, and no piece continued the path.
+    ///
+    /// Each snapped α must put the rows it is taken from within the thresholds. Other
+    /// points are returned unchanged. "Vanishes" is judged against the forces along the
+    /// piece the path came by (`entry`: the point where it entered it), not against the
+    /// point's own: there the forces are rounding noise of the piece's solves, as large as
     /// themselves, and no class would fit them.
-    pub(super) fn snap_to_vertex(&mut self, pt: Point, tol: &Tol, entry: &Point) -> Result<Point> {
+    pub(super) fn snap_to_vertex(
+        &mut self,
+        pt: Point,
+        tol: &Tol,
+        entry: &Point,
+        classes: &[Class],
+        crossing: &[Guard],
+    ) -> Result<Point> {
         let p = self.problem.p();
         let z = self.opts.zero_tol;
         let reference = self.force_scale(&pt).max(self.force_scale(entry));
@@ -685,37 +707,66 @@ impl Path {
             return Ok(pt);
         }
         let m = 2 * p;
-        let alpha = if self.load.is_affine() {
-            // From the load's parts, α* = −(q0 − g)·q1 / |q1|²: exactly 0 for a homogeneous
-            // load (q0 = g = 0), where every tolerance at the vertex is relative to zero.
-            // Both parts are divided by their largest entry first: the squares of loads
-            // beyond 1e154 overflow (α* was inf / inf = NaN there, and a NaN point passed
-            // the test below).
-            let (q0, q1) = self.load.q(0.0, self.problem.delassus())?;
-            let qg = shift_gap(&q0, self.problem.gap_equilibrated());
-            let s = inf_norm(&qg).max(inf_norm(&q1));
-            let (num, den) = qg.iter().zip(&q1).fold((0.0, 0.0), |(a, b), (x, y)| {
-                let (x, y) = (x / s, y / s);
-                (a + x * y, b + y * y)
-            });
-            let alpha = -num / den;
-            if den > 0.0 && alpha.is_finite() {
-                alpha
+        // The rows the snapped point must hold at zero, each set tried in turn.
+        let mut row_sets: Vec<Vec<usize>> = vec![(0..m).collect()];
+        if self.load.is_affine() {
+            let held: Vec<usize> = classes
+                .iter()
+                .enumerate()
+                .flat_map(|(i, &c)| match c {
+                    Class::Open => vec![],
+                    Class::Stick => vec![i, p + i],
+                    Class::SlipPlus | Class::SlipMinus => vec![i],
+                })
+                .collect();
+            if held.is_empty() {
+                // A gap guard of an open node crossing (on a piece with no contact force
+                // λ = 0 exactly, and the gap is q_k(α) − g_k).
+                row_sets.extend(
+                    crossing
+                        .iter()
+                        .filter(|g| classes[g.node] == Class::Open)
+                        .map(|g| vec![g.node]),
+                );
+            } else if held.len() < m {
+                row_sets.push(held);
+            }
+        }
+        for rows in row_sets {
+            let alpha = if self.load.is_affine() {
+                // From the load's parts, α* = −(q0 − g)·q1 / |q1|² on those rows: exactly
+                // 0 for a homogeneous load (q0 = g = 0 there), where every tolerance at the
+                // vertex is relative to zero. Both parts are divided by their largest entry
+                // first: the squares of loads beyond 1e154 overflow (α* was inf / inf =
+                // NaN there, and a NaN point passed the test below).
+                let (q0, q1) = self.load.q(0.0, self.problem.delassus())?;
+                let qg = shift_gap(&q0, self.problem.gap_equilibrated());
+                let s = rows
+                    .iter()
+                    .fold(0.0f64, |a, &k| a.max(qg[k].abs()).max(q1[k].abs()));
+                let (num, den) = rows.iter().fold((0.0, 0.0), |(a, b), &k| {
+                    let (x, y) = (qg[k] / s, q1[k] / s);
+                    (a + x * y, b + y * y)
+                });
+                let alpha = -num / den;
+                if den > 0.0 && alpha.is_finite() {
+                    alpha
+                } else {
+                    pt.alpha
+                }
             } else {
                 pt.alpha
+            };
+            let snapped = self.point_at(vec![0.0; m], alpha)?;
+            let qg = shift_gap(&snapped.q, self.problem.gap_equilibrated());
+            let off = rows.iter().fold(0.0f64, |a, &k| a.max(qg[k].abs()));
+            if qg.iter().all(|v| v.is_finite())
+                && self.problem.default_r() * off <= tol.disp.max(z * reference)
+            {
+                return Ok(snapped);
             }
-        } else {
-            pt.alpha
-        };
-        let snapped = self.point_at(vec![0.0; m], alpha)?;
-        let qg = shift_gap(&snapped.q, self.problem.gap_equilibrated());
-        if qg.iter().all(|v| v.is_finite())
-            && self.problem.default_r() * inf_norm(&qg) <= tol.disp.max(z * reference)
-        {
-            Ok(snapped)
-        } else {
-            Ok(pt)
         }
+        Ok(pt)
     }
 
     /// Moves onto candidate `k` of a pending transition and records its events.

@@ -1341,3 +1341,160 @@ pub fn assert_events_match_walk(ctx: &str, ev: &[fricont::Event], w: &Walk, tol:
     }
     folds
 }
+
+/// Plane-strain stiffness (E = 1, ν = 0.3, 2×2 Gauss) of an isoparametric Q1 element with
+/// corners `xy` counter-clockwise (any convex quadrilateral; [`assemble_q1`]'s elements
+/// are its rectangles).
+fn q1_iso_element(xy: [(f64, f64); 4]) -> [[f64; 8]; 8] {
+    let (e, nu) = (1.0, 0.3);
+    let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let d = [
+        [c * (1.0 - nu), c * nu, 0.0],
+        [c * nu, c * (1.0 - nu), 0.0],
+        [0.0, 0.0, c * (1.0 - 2.0 * nu) / 2.0],
+    ];
+    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
+    let g = 1.0 / 3f64.sqrt();
+    let mut ke = [[0.0; 8]; 8];
+    for (gx, gy) in [(-g, -g), (g, -g), (g, g), (-g, g)] {
+        // shape-function derivatives in the reference square, then the Jacobian
+        let dn = corners.map(|(xa, ya)| (0.25 * xa * (1.0 + ya * gy), 0.25 * ya * (1.0 + xa * gx)));
+        let mut j = [[0.0; 2]; 2];
+        for (a, &(dxi, deta)) in dn.iter().enumerate() {
+            j[0][0] += dxi * xy[a].0;
+            j[0][1] += dxi * xy[a].1;
+            j[1][0] += deta * xy[a].0;
+            j[1][1] += deta * xy[a].1;
+        }
+        let det = j[0][0] * j[1][1] - j[0][1] * j[1][0];
+        assert!(det > 0.0, "an inverted element");
+        let mut b = [[0.0; 8]; 3];
+        for (a, &(dxi, deta)) in dn.iter().enumerate() {
+            let dx = (j[1][1] * dxi - j[0][1] * deta) / det;
+            let dy = (-j[1][0] * dxi + j[0][0] * deta) / det;
+            b[0][2 * a] = dx;
+            b[1][2 * a + 1] = dy;
+            b[2][2 * a] = dy;
+            b[2][2 * a + 1] = dx;
+        }
+        for (r, row) in ke.iter_mut().enumerate() {
+            for (s, v) in row.iter_mut().enumerate() {
+                let mut sum = 0.0;
+                for k in 0..3 {
+                    for l in 0..3 {
+                        sum += b[k][r] * d[k][l] * b[l][s];
+                    }
+                }
+                *v += sum * det;
+            }
+        }
+    }
+    ke
+}
+
+/// A curved body: plane-strain isoparametric Q1 elements on a mapped `nx × ny` grid over
+/// x ∈ [−a, a], graded towards the middle (spacing ratio up to 10 between the middle and
+/// the ends), its bottom the parabola `y = κ x²`, its top `y = H` clamped (its dofs
+/// eliminated), the rows sheared sideways by up to 0.3 H. Every bottom node (p = nx + 1)
+/// rests on the flat rigid foundation `y = −g0` (`N u = −u_y`, `T u = ±u_x`, the sign by
+/// seed), its gap `κ x² + g0` (g0 = 0 in a third of the seeds, an overlap of up to 0.01
+/// in some). f0: small random forces plus a sideways body force; f1: a downward body force
+/// plus a sideways one. With `through_zero`: nx even (a node at the apex, x = 0), g0 = 0
+/// and f0 = 0, so that the load `α f1` passes through zero at α = 0 with the apex node
+/// alone at zero gap (all forces vanish there, and that node is at the vertex).
+pub fn curved_body(seed: u64, through_zero: bool) -> Case {
+    let mut rng = Rng::new(seed * 6151 + 3);
+    let mut nx = rng.int(4, 40);
+    if through_zero {
+        nx += nx % 2;
+    }
+    let ny = rng.int(1, 6);
+    let friction = [0.1, 0.3, 0.8, 1.5, 3.0, 5.0][rng.int(0, 5)];
+    let (half, height) = (rng.range(0.5, 2.0), rng.range(0.2, 1.5));
+    let curv = rng.range(0.0, 0.5) * height / (half * half);
+    let (grade, skew) = (rng.range(0.0, 0.9), rng.range(-0.3, 0.3));
+    let node = |i: usize, j: usize| -> (f64, f64) {
+        // s ∈ [−1, 1], exactly 0 at i = nx / 2 for an even nx
+        let s = (2 * i) as f64 / nx as f64 - 1.0;
+        let x = half * (s - 0.5 * grade * s * (1.0 - s * s));
+        let bottom = curv * x * x;
+        let t = j as f64 / ny as f64;
+        (
+            x + skew * t * (1.0 - t) * height,
+            bottom + t * (height - bottom),
+        )
+    };
+    let dof = |i: usize, j: usize, k: usize| (j < ny).then(|| 2 * (j * (nx + 1) + i) + k);
+    let n = 2 * (nx + 1) * ny;
+    let mut a = DMatrix::zeros(n, n);
+    for ei in 0..nx {
+        for ej in 0..ny {
+            let nodes = [(ei, ej), (ei + 1, ej), (ei + 1, ej + 1), (ei, ej + 1)];
+            let ke = q1_iso_element(nodes.map(|(i, j)| node(i, j)));
+            for (la, &(ia, ja)) in nodes.iter().enumerate() {
+                for ka in 0..2 {
+                    let Some(r) = dof(ia, ja, ka) else { continue };
+                    for (lb, &(ib, jb)) in nodes.iter().enumerate() {
+                        for kb in 0..2 {
+                            if let Some(c) = dof(ib, jb, kb) {
+                                a[(r, c)] += ke[2 * la + ka][2 * lb + kb];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let at = a.transpose();
+    a = (a + at) * 0.5;
+    let p = nx + 1;
+    let mut nm = DMatrix::zeros(p, n);
+    let mut tm = DMatrix::zeros(p, n);
+    let t_sign = if seed.is_multiple_of(2) { 1.0 } else { -1.0 };
+    for i in 0..p {
+        nm[(i, dof(i, 0, 1).unwrap())] = -1.0;
+        tm[(i, dof(i, 0, 0).unwrap())] = t_sign;
+    }
+    let g0 = if through_zero || seed.is_multiple_of(3) {
+        0.0
+    } else {
+        rng.range(-0.01, 0.02)
+    };
+    let gap = (0..p).map(|i| node(i, 0).1 + g0).collect();
+    let cells = (n / 2) as f64;
+    let (down, side0, side1) = (
+        rng.range(0.05, 0.3),
+        rng.range(-0.1, 0.1),
+        rng.range(-0.2, 0.2),
+    );
+    let mut f0 = DVector::zeros(n);
+    let mut f1 = DVector::zeros(n);
+    for j in 0..ny {
+        for i in 0..p {
+            let r = dof(i, j, 0).unwrap();
+            if !through_zero {
+                f0[r] += rng.range(-0.005, 0.005) + side0 / cells;
+                f0[r + 1] += rng.range(-0.005, 0.005);
+            }
+            f1[r] += side1 / cells;
+            f1[r + 1] -= down / cells;
+        }
+    }
+    let data = Data {
+        n,
+        p,
+        a,
+        nm,
+        tm,
+        friction: vec![friction; p],
+        gap,
+        f0,
+        f1,
+    };
+    let (a0, a1) = if seed % 5 == 2 {
+        (4.0, -1.0)
+    } else {
+        (-1.0, 4.0)
+    };
+    Case { seed, data, a0, a1 }
+}
