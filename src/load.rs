@@ -209,7 +209,7 @@ pub(crate) struct BoundLoad {
     /// The last few `(α, w(α))` of a basis load, newest last: the term magnitudes at a
     /// point ([`Self::term_magnitude_rows`]) must not depend on which α was evaluated
     /// since (the tracer evaluates the entry of a piece after its exit point).
-    recent_weights: Vec<(f64, Vec<f64>)>,
+    recent_weights: Vec<(f64, Vec<f64>, Vec<f64>)>,
     /// A general load's last evaluation: the tracer often asks again at the same α (a
     /// root, then the join at it), and each evaluation costs the user's callbacks and a
     /// solve with A.
@@ -608,6 +608,30 @@ impl BoundLoad {
         )
     }
 
+    /// `Σ_j |w'_j(α)| |q_j,k|` for a basis load whose weights were evaluated at α lately:
+    /// the magnitude of the terms of `q'_k(α)`. None otherwise.
+    pub(crate) fn term_rate_rows(&self, alpha: f64) -> Option<Vec<f64>> {
+        let Load::Basis { .. } = &self.load else {
+            return None;
+        };
+        let (_, _, dw) = self
+            .recent_weights
+            .iter()
+            .rev()
+            .find(|(a, _, _)| *a == alpha)?;
+        let m = self.q_basis.first()?.len();
+        Some(
+            (0..m)
+                .map(|k| {
+                    dw.iter()
+                        .zip(&self.q_basis)
+                        .map(|(d, qj)| d.abs() * qj[k].abs())
+                        .sum()
+                })
+                .collect(),
+        )
+    }
+
     /// `|w_j(α)|`: `(1, |α|)` for an affine load; a basis load's weights at α if among its
     /// last few evaluations, or else, with `latest`, its latest ones. None for a general
     /// load (or a basis load's weights not at hand).
@@ -616,8 +640,8 @@ impl BoundLoad {
             Load::Affine { .. } => Some(vec![1.0, alpha.abs()]),
             Load::Basis { .. } => {
                 let mut recent = self.recent_weights.iter().rev();
-                let at = recent.clone().find(|(a, _)| *a == alpha);
-                let (_, w) = if latest { at.or(recent.next())? } else { at? };
+                let at = recent.clone().find(|(a, _, _)| *a == alpha);
+                let (_, w, _) = if latest { at.or(recent.next())? } else { at? };
                 Some(w.iter().map(|w| w.abs()).collect())
             }
             Load::General { .. } => None,
@@ -782,7 +806,8 @@ impl BoundLoad {
         if self.recent_weights.len() == RECENT {
             self.recent_weights.remove(0);
         }
-        self.recent_weights.push((alpha, self.weights.clone()));
+        self.recent_weights
+            .push((alpha, self.weights.clone(), self.dweights.clone()));
         Ok(())
     }
 

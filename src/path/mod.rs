@@ -1052,7 +1052,10 @@ impl Path {
     }
 
     /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
-    /// ([`BoundLoad::term_magnitude_rows`]); for a general load, whose terms are not
+    /// ([`BoundLoad::term_magnitude_rows`]), a basis load's plus its change since the
+    /// current piece's entry α_e, `|α − α_e| Σ_j |w'_j(α)| |q_j|`
+    /// ([`BoundLoad::term_rate_rows`]: a point's q and λ on the piece carry that
+    /// change's rounding, which does not vanish where the weights do); for a general load, whose terms are not
     /// known, `|q_k| + L |q'_k|` (the change of q over an α length L: the window's, but
     /// no more than the point's own, see [`Self::load_span`]). With whether they are
     /// estimated so.
@@ -1071,7 +1074,24 @@ impl Path {
     /// merged or moved events there without an error; 2 do now (their first transition).
     fn term_rows(&self, pt: &Point) -> (Vec<f64>, bool) {
         match self.load.term_magnitude_rows(pt.alpha) {
-            Some(rows) => (rows, false),
+            Some(mut rows) => {
+                // A basis load's q at a point reached along a piece is found relative to
+                // the piece's entry: its rounding holds the change since the entry,
+                // |α − α_e| |q'|ₜ, which does not vanish where the weights do.
+                if let Some(rate) = self.load.term_rate_rows(pt.alpha) {
+                    let from = match &self.trace {
+                        Some(tr) => tr.cur.alpha,
+                        None => self.opts.alpha_start,
+                    };
+                    let span = (pt.alpha - from).abs();
+                    if span.is_finite() {
+                        for (r, d) in rows.iter_mut().zip(&rate) {
+                            *r += span * d;
+                        }
+                    }
+                }
+                (rows, false)
+            }
             None => {
                 let from = match &self.trace {
                     Some(tr) => tr.cur.alpha,
