@@ -206,9 +206,10 @@ pub(crate) struct BoundLoad {
     dweights: Vec<f64>,
     /// α of `weights` (NaN before the first evaluation).
     weights_alpha: f64,
-    /// The last few `(α, w(α))` of a basis load, newest last: the term magnitudes at a
-    /// point ([`Self::term_magnitude_rows`]) must not depend on which α was evaluated
-    /// since (the tracer evaluates the entry of a piece after its exit point).
+    /// The last few `(α, w(α), w'(α))` of a basis load, newest last: the term magnitudes
+    /// at a point ([`Self::term_magnitude_rows`], [`Self::term_rate_rows`]) must not
+    /// depend on which α was evaluated since (the tracer evaluates the entry of a piece
+    /// after its exit point).
     recent_weights: Vec<(f64, Vec<f64>, Vec<f64>)>,
     /// A general load's last evaluation: the tracer often asks again at the same α (a
     /// root, then the join at it), and each evaluation costs the user's callbacks and a

@@ -1054,11 +1054,11 @@ impl Path {
     /// The magnitude of the terms of each row of `q(α)`: exact for affine and basis loads
     /// ([`BoundLoad::term_magnitude_rows`]), a basis load's plus its change since the
     /// current piece's entry α_e, `|α − α_e| Σ_j |w'_j(α)| |q_j|`
-    /// ([`BoundLoad::term_rate_rows`]: a point's q and λ on the piece carry that
-    /// change's rounding, which does not vanish where the weights do); for a general load, whose terms are not
-    /// known, `|q_k| + L |q'_k|` (the change of q over an α length L: the window's, but
-    /// no more than the point's own, see [`Self::load_span`]). With whether they are
-    /// estimated so.
+    /// ([`BoundLoad::term_rate_rows`]: a point's q and λ on the piece carry that change's
+    /// rounding, which does not vanish where the weights do); for a general load, whose
+    /// terms are not known, `|q_k| + L |q'_k|` (the change of q over an α length L: the
+    /// window's, but no more than the point's own, see [`Self::load_span`]). With whether
+    /// they are estimated so.
     ///
     /// The estimate cannot tell a load whose terms cancel (where it passes through zero)
     /// from one that is small by itself, and it errs to the larger: thresholds too large
@@ -1073,16 +1073,16 @@ impl Path {
     /// of the load's size at the start, and 23 of 160 traces (random problems and meshes)
     /// merged or moved events there without an error; 2 do now (their first transition).
     fn term_rows(&self, pt: &Point) -> (Vec<f64>, bool) {
+        let from = match &self.trace {
+            Some(tr) => tr.cur.alpha,
+            None => self.opts.alpha_start,
+        };
         match self.load.term_magnitude_rows(pt.alpha) {
             Some(mut rows) => {
                 // A basis load's q at a point reached along a piece is found relative to
                 // the piece's entry: its rounding holds the change since the entry,
                 // |α − α_e| |q'|ₜ, which does not vanish where the weights do.
                 if let Some(rate) = self.load.term_rate_rows(pt.alpha) {
-                    let from = match &self.trace {
-                        Some(tr) => tr.cur.alpha,
-                        None => self.opts.alpha_start,
-                    };
                     let span = (pt.alpha - from).abs();
                     if span.is_finite() {
                         for (r, d) in rows.iter_mut().zip(&rate) {
@@ -1093,10 +1093,6 @@ impl Path {
                 (rows, false)
             }
             None => {
-                let from = match &self.trace {
-                    Some(tr) => tr.cur.alpha,
-                    None => self.opts.alpha_start,
-                };
                 let span = self.load_span(pt, 1.0, from);
                 let rows =
                     pt.q.iter()

@@ -1067,13 +1067,7 @@ fn assemble_q1(
     n: usize,
     dof: impl Fn(usize, usize, usize) -> Option<usize>,
 ) -> DMatrix<f64> {
-    let (e, nu) = (1.0, 0.3);
-    let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
-    let d = [
-        [c * (1.0 - nu), c * nu, 0.0],
-        [c * nu, c * (1.0 - nu), 0.0],
-        [0.0, 0.0, c * (1.0 - 2.0 * nu) / 2.0],
-    ];
+    let d = plane_strain();
     // element stiffness (8×8), local nodes (0,0), (1,0), (1,1), (0,1)
     let xi = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
     let g = 1.0 / 3f64.sqrt();
@@ -1101,9 +1095,24 @@ fn assemble_q1(
             }
         }
     }
+    assemble_elements(nx, ny, n, dof, |_, _| ke)
+}
+
+/// The stiffness matrix (n × n) of an `nx × ny` grid of Q1 elements, element `(ei, ej)`
+/// (nodes `(ei, ej)`, `(ei + 1, ej)`, `(ei + 1, ej + 1)`, `(ei, ej + 1)`) with stiffness
+/// `ke_of(ei, ej)`; `dof(i, j, k)` is the dof of node `(i, j)` in direction k, None where
+/// it is eliminated (clamped).
+fn assemble_elements(
+    nx: usize,
+    ny: usize,
+    n: usize,
+    dof: impl Fn(usize, usize, usize) -> Option<usize>,
+    ke_of: impl Fn(usize, usize) -> [[f64; 8]; 8],
+) -> DMatrix<f64> {
     let mut a = DMatrix::zeros(n, n);
     for ei in 0..nx {
         for ej in 0..ny {
+            let ke = ke_of(ei, ej);
             let nodes = [(ei, ej), (ei + 1, ej), (ei + 1, ej + 1), (ei, ej + 1)];
             for (la, &(ia, ja)) in nodes.iter().enumerate() {
                 for ka in 0..2 {
@@ -1342,17 +1351,23 @@ pub fn assert_events_match_walk(ctx: &str, ev: &[fricont::Event], w: &Walk, tol:
     folds
 }
 
+/// The plane-strain material matrix for E = 1, ν = 0.3 (stresses from strains
+/// `(ε_xx, ε_yy, γ_xy)`).
+fn plane_strain() -> [[f64; 3]; 3] {
+    let (e, nu) = (1.0, 0.3);
+    let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    [
+        [c * (1.0 - nu), c * nu, 0.0],
+        [c * nu, c * (1.0 - nu), 0.0],
+        [0.0, 0.0, c * (1.0 - 2.0 * nu) / 2.0],
+    ]
+}
+
 /// Plane-strain stiffness (E = 1, ν = 0.3, 2×2 Gauss) of an isoparametric Q1 element with
 /// corners `xy` counter-clockwise (any convex quadrilateral; [`assemble_q1`]'s elements
 /// are its rectangles).
 fn q1_iso_element(xy: [(f64, f64); 4]) -> [[f64; 8]; 8] {
-    let (e, nu) = (1.0, 0.3);
-    let c = e / ((1.0 + nu) * (1.0 - 2.0 * nu));
-    let d = [
-        [c * (1.0 - nu), c * nu, 0.0],
-        [c * nu, c * (1.0 - nu), 0.0],
-        [0.0, 0.0, c * (1.0 - 2.0 * nu) / 2.0],
-    ];
+    let d = plane_strain();
     let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
     let g = 1.0 / 3f64.sqrt();
     let mut ke = [[0.0; 8]; 8];
@@ -1426,25 +1441,10 @@ pub fn curved_body(seed: u64, through_zero: bool) -> Case {
     };
     let dof = |i: usize, j: usize, k: usize| (j < ny).then(|| 2 * (j * (nx + 1) + i) + k);
     let n = 2 * (nx + 1) * ny;
-    let mut a = DMatrix::zeros(n, n);
-    for ei in 0..nx {
-        for ej in 0..ny {
-            let nodes = [(ei, ej), (ei + 1, ej), (ei + 1, ej + 1), (ei, ej + 1)];
-            let ke = q1_iso_element(nodes.map(|(i, j)| node(i, j)));
-            for (la, &(ia, ja)) in nodes.iter().enumerate() {
-                for ka in 0..2 {
-                    let Some(r) = dof(ia, ja, ka) else { continue };
-                    for (lb, &(ib, jb)) in nodes.iter().enumerate() {
-                        for kb in 0..2 {
-                            if let Some(c) = dof(ib, jb, kb) {
-                                a[(r, c)] += ke[2 * la + ka][2 * lb + kb];
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    }
+    let mut a = assemble_elements(nx, ny, n, dof, |ei, ej| {
+        let corners = [(ei, ej), (ei + 1, ej), (ei + 1, ej + 1), (ei, ej + 1)];
+        q1_iso_element(corners.map(|(i, j)| node(i, j)))
+    });
     let at = a.transpose();
     a = (a + at) * 0.5;
     let p = nx + 1;
