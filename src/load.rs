@@ -595,18 +595,7 @@ impl BoundLoad {
     /// `|q_k(α)|`, which can cancel to zero. `None` for a general load (or basis weights
     /// not evaluated at α lately).
     pub(crate) fn term_magnitude_rows(&self, alpha: f64) -> Option<Vec<f64>> {
-        let w = self.abs_weights(alpha, false)?;
-        let m = self.q_basis.first()?.len();
-        Some(
-            (0..m)
-                .map(|k| {
-                    w.iter()
-                        .zip(&self.q_basis)
-                        .map(|(wj, qj)| wj * qj[k].abs())
-                        .sum()
-                })
-                .collect(),
-        )
+        self.abs_combination(&self.abs_weights(alpha, false)?)
     }
 
     /// `Σ_j |w'_j(α)| |q_j,k|` for a basis load whose weights were evaluated at α lately:
@@ -620,13 +609,18 @@ impl BoundLoad {
             .iter()
             .rev()
             .find(|(a, _, _)| *a == alpha)?;
+        self.abs_combination(dw)
+    }
+
+    /// `Σ_j |c_j| |q_j,k|` for each row k of the basis vectors (None without any).
+    fn abs_combination(&self, c: &[f64]) -> Option<Vec<f64>> {
         let m = self.q_basis.first()?.len();
         Some(
             (0..m)
                 .map(|k| {
-                    dw.iter()
+                    c.iter()
                         .zip(&self.q_basis)
-                        .map(|(d, qj)| d.abs() * qj[k].abs())
+                        .map(|(cj, qj)| cj.abs() * qj[k].abs())
                         .sum()
                 })
                 .collect(),

@@ -719,18 +719,20 @@ impl Path {
         let z = self.opts.zero_tol;
         let reference = self.force_scale(&pt).max(self.force_scale(entry));
         let forces = inf_norm(&pt.lam);
-        let vanished = forces <= tol.disp.max(z * reference);
+        let loose = tol.disp.max(z * reference);
+        let vanished = forces <= loose;
+        let affine = self.load.is_affine();
         // Under an affine load the point may also be near one where the forces vanish:
         // the piece's λ is affine in α, and its roots carry the error of the piece's
         // tangent (cond · ε) times the piece's length in α, not only rounding.
-        let near = self.load.is_affine() && forces <= NEAR_VANISHING * reference;
+        let near = affine && forces <= NEAR_VANISHING * reference;
         if !vanished && !near {
             return Ok(pt);
         }
         let m = 2 * p;
         // The rows the snapped point must hold at zero, each set tried in turn.
         let mut row_sets: Vec<Vec<usize>> = vec![(0..m).collect()];
-        if self.load.is_affine() {
+        if affine {
             let held: Vec<usize> = classes
                 .iter()
                 .enumerate()
@@ -753,15 +755,20 @@ impl Path {
                 row_sets.push(held);
             }
         }
+        // An affine load's parts, `q0 − (g, 0)` and `q1`, for α* in closed form.
+        let parts = if affine {
+            let (q0, q1) = self.load.q(0.0, self.problem.delassus())?;
+            Some((shift_gap(&q0, self.problem.gap_equilibrated()), q1))
+        } else {
+            None
+        };
         for rows in row_sets {
-            let alpha = if self.load.is_affine() {
-                // From the load's parts, α* = −(q0 − g)·q1 / |q1|² on those rows: exactly
-                // 0 for a homogeneous load (q0 = g = 0 there), where every tolerance at the
-                // vertex is relative to zero. Both parts are divided by their largest entry
-                // first: the squares of loads beyond 1e154 overflow (α* was inf / inf =
-                // NaN there, and a NaN point passed the test below).
-                let (q0, q1) = self.load.q(0.0, self.problem.delassus())?;
-                let qg = shift_gap(&q0, self.problem.gap_equilibrated());
+            let alpha = if let Some((qg, q1)) = &parts {
+                // α* = −(q0 − g)·q1 / |q1|² on those rows: exactly 0 for a homogeneous
+                // load (q0 = g = 0 there), where every tolerance at the vertex is relative
+                // to zero. Both parts are divided by their largest entry first: the squares
+                // of loads beyond 1e154 overflow (α* was inf / inf = NaN there, and a NaN
+                // point passed the test below).
                 let s = rows
                     .iter()
                     .fold(0.0f64, |a, &k| a.max(qg[k].abs()).max(q1[k].abs()));
@@ -785,7 +792,7 @@ impl Path {
             let close = vanished
                 || (alpha - pt.alpha).abs() <= NEAR_VANISHING * (entry.alpha - pt.alpha).abs();
             if !(qg.iter().all(|v| v.is_finite())
-                && self.problem.default_r() * off <= tol.disp.max(z * reference)
+                && self.problem.default_r() * off <= loose
                 && close)
             {
                 continue;

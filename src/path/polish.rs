@@ -252,17 +252,17 @@ impl Refiner<'_> {
                 // the solution, step² / size (a double-precision solve is off by about
                 // cond · ε of it, and each round contracts by about cond · ε), so a first
                 // round ends the refinement only where the correction is within about
-                // √CONVERGED (1e-12) of the solution. It used to end it where the correction was within 1e-4:
-                // on two stacked blocks (p = 640, F = 0.3, κ(W) = 2.3e7) a rate corrected
-                // by 5.7e-7 of itself in one round kept enough error to move the slope of a
-                // guard that is a small difference of large terms (a node's tangential
-                // displacement, 3.3e-6 per unit α against displacements of 1.4), and the
-                // exit at the end of that piece lay up to 3.1e-7 in α off where copies of
-                // the problem with rows scaled by other factors put it (double alone:
-                // 5e-10). With a second round every copy agrees to the last bit. (Before,
-                // taking every first round as enough, a rate corrected by 4.5e-4 of itself
-                // on a slender strip kept 4.3e-6 of error and its exit was 4.7e-9 in α off
-                // the independent reference.)
+                // √CONVERGED (1e-12) of the solution. It used to end it where the
+                // correction was within 1e-4: on two stacked blocks (p = 640, F = 0.3,
+                // κ(W) = 2.3e7) a rate corrected by 5.7e-7 of itself in one round kept
+                // enough error to move the slope of a guard that is a small difference of
+                // large terms (a node's tangential displacement, 3.3e-6 per unit α against
+                // displacements of 1.4), and the exit at the end of that piece lay up to
+                // 3.1e-7 in α off where copies of the problem with rows scaled by other
+                // factors put it (double alone: 5e-10). With a second round every copy
+                // agrees to the last bit. (Before, taking every first round as enough, a
+                // rate corrected by 4.5e-4 of itself on a slender strip kept 4.3e-6 of error
+                // and its exit was 4.7e-9 in α off the independent reference.)
                 let before = if last[j].is_finite() { last[j] } else { size };
                 let predicted = step * (step / before) <= CONVERGED * scale;
                 if step <= CONVERGED * scale || predicted {
