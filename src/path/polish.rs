@@ -24,8 +24,12 @@ use crate::dense::mat_mul;
 use crate::piece::LinForm;
 
 /// Most refinement rounds of one solve (a piece whose rounds contract by 1e-2 each
-/// needed 11 from a first correction of 4.5e-4 of the solution).
-const MAX_ROUNDS: usize = 16;
+/// needed 11 from a first correction of 4.5e-4 of the solution). A round costs one solve
+/// and one pass over W, and rounds that stop contracting end the refinement before
+/// this: near a fold of the 1201 × 11 strip (F = 5, κ(W) 1.2e11) rates contracting by
+/// 0.3–0.5 per round took up to 50 rounds (16 were allowed, and those pieces' exits
+/// stayed in double, up to 5e-6 in α off).
+const MAX_ROUNDS: usize = 64;
 /// A correction this small relative to the solution's scale (max|x| or the data's force
 /// scale, see [`Refiner::refine_all`]) ends the refinement.
 const CONVERGED: f64 = 1e-24;
@@ -35,8 +39,11 @@ const STALLED: f64 = 1e-20;
 /// A correction larger than this (relative to the solution's scale) ends the refinement
 /// as failed: the guess, a double-precision solution, is then not within cond · ε of the
 /// piece's (garbage from a nearly singular piece). On the p = 1920 strip, cond · ε
-/// reaches 1e-4 of λ, and the refinement still contracts by that factor per round.
-const ROUGH: f64 = 1e-2;
+/// reaches 1e-4 of λ, and the refinement still contracts by that factor per round; near
+/// a fold of the 1201 × 11 strip (F = 5) rates were 1–2.2e-2 off and refined (with 1e-2
+/// those pieces' exits stayed in double). A refinement accepted has converged on
+/// residuals in double-double, whatever its first step.
+const ROUGH: f64 = 0.25;
 /// See [`near`].
 const NEAR: f64 = 1e-5;
 
@@ -110,7 +117,8 @@ fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
 }
 
 /// The piece's solves `b ↦ M_S⁻¹ b` for several columns at once (seed's row scaling).
-type PieceSolve<'a> = Box<dyn Fn(&[Vec<f64>]) -> Vec<Vec<f64>> + 'a>;
+type SolveFn<'a> = dyn Fn(&[Vec<f64>]) -> Vec<Vec<f64>> + 'a;
+type PieceSolve<'a> = Box<SolveFn<'a>>;
 
 /// What a refinement on one piece needs: the constants, W (both parts), the load's
 /// parts in double-double, and the piece's solves.
@@ -120,6 +128,8 @@ struct Refiner<'a> {
     w_lo: Option<MatRef<'a, f64>>,
     classes: &'a [Class],
     solve: PieceSolve<'a>,
+    /// Whether `solve` is the piece's updated factorisation (see [`Self::refine_all`]).
+    updated: bool,
     /// The load's condensed vectors (high, low): q0 and q1 of an affine load, the q_j of
     /// a basis load.
     q: Vec<(Vec<f64>, Vec<f64>)>,
@@ -195,7 +205,30 @@ impl Refiner<'_> {
     /// the march kept the double-precision points, and the lift-off came 1.1e-8 in α
     /// early. Only the first round's test, whose correction stands for the contraction,
     /// stays relative to max|x| (a tiny x then takes more rounds).
+    ///
+    /// Where the piece's solves are its updated factorisation and the refinement fails,
+    /// it is tried again with a fresh LU of the piece matrix (O(m³), once): an updated
+    /// solve is a poorer approximate inverse on a nearly singular piece (near a fold of the
+    /// 1201 × 11 strip, F = 5, rate corrections of 2.0e-2 and then 2.7e-2 did not contract
+    /// where a fresh LU's did, and the exit kept in double, 2e-5 in α off, made the path
+    /// turn back at a fold it does not have).
     fn refine_all(&self, pairs: Vec<(DdVec, DdVec)>) -> Option<Vec<(DdVec, DdVec)>> {
+        if !self.updated {
+            return self.refine_by(&self.solve, pairs);
+        }
+        self.refine_by(&self.solve, pairs.clone()).or_else(|| {
+            let lu = DenseLu::new(self.c.piece_matrix(self.w, self.classes).as_ref());
+            let fresh = |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect();
+            self.refine_by(&fresh, pairs)
+        })
+    }
+
+    /// [`Self::refine_all`] with the piece's solves `solve`.
+    fn refine_by(
+        &self,
+        solve: &SolveFn<'_>,
+        pairs: Vec<(DdVec, DdVec)>,
+    ) -> Option<Vec<(DdVec, DdVec)>> {
         let floors: Vec<f64> = pairs.iter().map(|(_, c)| self.floor(c)).collect();
         let refs: Vec<(&DdVec, &DdVec)> = pairs.iter().map(|(x, c)| (x, c)).collect();
         let ds = gaps_dd(self.w, self.w_lo, &refs);
@@ -225,7 +258,7 @@ impl Refiner<'_> {
                     r
                 })
                 .collect();
-            let dxs = (self.solve)(&rs);
+            let dxs = solve(&rs);
             let wdx = mat_mul(self.w, &dxs.iter().map(|v| &v[..]).collect::<Vec<_>>());
             for ((&j, dx), wdx) in active.iter().zip(&dxs).zip(wdx) {
                 let (x, d) = &mut xs[j];
@@ -382,6 +415,7 @@ impl Path {
             w_lo: del.w_lo(),
             classes,
             solve,
+            updated: updated.is_some(),
             q,
             gap: problem.gap_equilibrated(),
         })
