@@ -7,6 +7,7 @@
 
 use std::sync::Arc;
 
+use fricont::load::{Load, LoadFailure};
 use fricont::path::{Path, PathOptions};
 use fricont::{Class, CsrMatrix, ExtendedPrecision};
 use fricont_exchange::generator::{RectSpec, Side, Traction, generate};
@@ -126,6 +127,11 @@ type Ev = (f64, usize, Class, Class);
 /// `max_steps`, those of its first transition points (else the path must end at the
 /// window).
 fn events(case: &CaseData, max_steps: Option<usize>) -> (Vec<Ev>, f64) {
+    events_under(case, case.load().unwrap(), max_steps)
+}
+
+/// [`events`] under `load` instead of the case's own.
+fn events_under(case: &CaseData, load: Load, max_steps: Option<usize>) -> (Vec<Ev>, f64) {
     let problem = Arc::new(
         case.builder()
             .extended_precision(ExtendedPrecision::On)
@@ -135,7 +141,7 @@ fn events(case: &CaseData, max_steps: Option<usize>) -> (Vec<Ev>, f64) {
     let kappa = problem.w_condition_estimate();
     let mut opts = PathOptions::window(case.alpha_start, case.alpha_end);
     opts.max_steps = max_steps.unwrap_or(opts.max_steps);
-    let mut path = Path::new(problem, case.load().unwrap(), opts).unwrap();
+    let mut path = Path::new(problem, load, opts).unwrap();
     path.start(case.alpha_start, None).unwrap();
     let end = path.run().unwrap();
     let want = if max_steps.is_some() {
@@ -207,17 +213,23 @@ fn factor(i: usize) -> f64 {
 /// The 1201 × 11 strip on 120 × 0.3 of the Python tests (`strip-1201x11`: F = 5,
 /// p = 1200, κ(W) ≈ 1e11, κ(A) ε ≈ 3e-4) and the same strip with node i's rows of N and
 /// T multiplied by `factor(i)` (their entries are ±1, so the scaled entries are exact and
-/// the copy is exactly the same problem), over their first 600 transition points: the
-/// same events, α to 1e-10. Between α = −1.703 and −1.698 the strip's contact nodes
-/// 429–440 stick, slip and open again and again on pieces near its folds, whose rates
-/// a double-precision solve gets up to 2.2e-2 wrong. Their refinement in double-double
-/// gave up there (a first correction above 1e-2, more than 16 rounds, or an updated
-/// factorisation whose rounds did not contract) on 6 pieces of the scaled copy, whose
-/// exits stayed in double: up to 4.7e-6 in α off the original's, and the copy stopped at
-/// its 558th transition point ("node 438 fits no class"); allowed 16 rounds more, it
-/// turned back at a fold that the strip does not have and went back to α = −2. (Beyond
-/// these 600, near the strip's free end, the copies differ by up to 2.3e-9: the floor of
-/// W's refinement, κ(A) ε² of A⁻¹Bᵀ, which κ(W) amplifies.)
+/// the copy is exactly the same problem), from α = −1.704 over 100 transition points: the
+/// same events, α to 1e-10. There the strip's contact nodes 425–442 stick, slip and open
+/// again and again on pieces near its folds, whose rates a double-precision solve gets up
+/// to 2.2e-2 wrong. Their refinement in double-double gave up on some of them (a first
+/// correction above 1e-2, more than 16 rounds, or an updated factorisation whose rounds
+/// did not contract), whose exits stayed in double: the copies' 97th transition points
+/// lay 1.6e-6 in α apart. Over the strip's whole window (−2 to 2) the scaled copy stopped
+/// at its 558th transition point ("node 438 fits no class"), and allowed 64 rounds alone
+/// it turned back at a fold that the strip does not have and went back to α = −2. (Near
+/// the strip's free end, later, the copies differ by up to 2.3e-9: the floor of W's
+/// refinement, κ(A) ε² of A⁻¹Bᵀ, which κ(W) amplifies.)
+///
+/// The scaled copy under the same load given as a basis load (vectors f0, f1, weights 1
+/// and α) walks the same path: there its basis solutions, refined in double-double, lay
+/// up to 5.2e-5 of max|y| from their double-precision solves and were dropped for them
+/// (1.5e-8 in α off at the 20th transition point; from α = −2, it left the path at its
+/// 589th event).
 #[test]
 fn a_thin_strip_near_its_folds_agrees_with_its_row_scaled_copy() {
     let spec = RectSpec {
@@ -226,7 +238,7 @@ fn a_thin_strip_near_its_folds_agrees_with_its_row_scaled_copy() {
         lx: 120.0,
         ly: 0.3,
         friction: 5.0,
-        alpha_start: -2.0,
+        alpha_start: -1.704,
         alpha_end: 2.0,
         load0: vec![
             traction(Side::Top, [-0.00833, -0.00732], [-0.00339, -0.00489]),
@@ -252,8 +264,18 @@ fn a_thin_strip_near_its_folds_agrees_with_its_row_scaled_copy() {
         t_mat: scale(&base.t_mat, "T"),
         ..base.clone()
     };
-    let (a, kappa) = events(&base, Some(600));
+    let (a, kappa) = events(&base, Some(100));
     assert!(kappa > 1e10, "condition estimate {kappa:e}");
-    let (b, _) = events(&scaled, Some(600));
+    let (b, _) = events(&scaled, Some(100));
     assert_same("rows scaled", &a, &b, 1e-10);
+    let basis = Load::basis(
+        vec![scaled.f0.clone(), scaled.f1.clone()],
+        Box::new(|alpha: f64, w: &mut [f64], dw: &mut [f64]| {
+            (w[0], w[1], dw[0], dw[1]) = (1.0, alpha, 0.0, 1.0);
+            Ok::<(), LoadFailure>(())
+        }),
+    )
+    .unwrap();
+    let (c, _) = events_under(&scaled, basis, Some(100));
+    assert_same("rows scaled, basis load", &a, &c, 1e-10);
 }

@@ -348,10 +348,11 @@ impl RefinedPiece {
 /// further checks only where the two lie within [`NEAR`] of each other (relative to
 /// max|λ|, or to `floor` where that is larger: the force scale of the data, see
 /// [`Refiner::refine_all`]): what double precision gets wrong on a slender body is ~1e-7
-/// at most (in α, and so in λ along the piece). A larger move means a piece whose point
-/// is ill-determined: the double point, found with the tracer's own checks, is kept,
-/// except by [`Path::polish_point`] where the refined point solves the piece from the
-/// data at least as well.
+/// (in α, and so in λ along the piece) on most pieces, up to 5e-5 near the folds of the
+/// 1201 × 11 strip (F = 5). A larger move may mean a piece whose point is ill-determined:
+/// the double point, found with the tracer's own checks, is kept, except by
+/// [`Path::polish_point`] and [`Path::refine_basis`] where the refined point solves the
+/// piece from the data at least as well, or within a solve's check.
 pub(super) fn near(lam2: &[f64], lam: &[f64], floor: f64) -> bool {
     let dl: Vec<f64> = lam2.iter().zip(lam).map(|(x, y)| x - y).collect();
     // (a NaN anywhere makes the norms NaN: not near)
@@ -427,7 +428,12 @@ impl Path {
     /// double-double). A combination of them is then accurate to a few roundings of its
     /// terms, where one of double-precision solves is off by cond · ε. None when the
     /// problem is not carried beyond double, the refinement does not converge, or it lands
-    /// farther from a solve than [`near`] allows: the caller keeps the solves.
+    /// farther from a solve than [`near`] allows and its rounding does not solve the
+    /// piece's equations from the data within a solve's check (relative residual 1e-12,
+    /// one product with W for all such): the caller keeps the solves. (Near the folds of
+    /// the 1201 × 11 strip, F = 5, refined solutions 2.8–5.2e-5 of max|y| from the solves
+    /// were dropped, and under a basis load of the affine path's weights the strip with
+    /// its rows scaled left that path at its 589th event.)
     pub(super) fn refine_basis(
         &mut self,
         cur: &CurrentPiece,
@@ -455,14 +461,32 @@ impl Path {
         let consts: Vec<DdVec> = pairs.iter().map(|(_, c)| c.clone()).collect();
         let refined = r.refine_all(pairs)?;
         let mut out = Vec::with_capacity(k + 1);
-        for ((x, d), (c, y)) in refined.iter().zip(consts.iter().zip(ys)) {
+        let mut far = Vec::new();
+        for (j, ((x, d), (c, y))) in refined.iter().zip(consts.iter().zip(ys)).enumerate() {
             let yr: Vec<f64> = (0..m).map(|i| x.get(i).to_f64()).collect();
             let wy: Vec<f64> = (0..m).map(|i| (d.get(i) - c.get(i)).to_f64()).collect();
-            let finite = yr.iter().chain(&wy).all(|v| v.is_finite());
-            if !finite || !near(&yr, y, r.floor(c)) {
+            if !yr.iter().chain(&wy).all(|v| v.is_finite()) {
                 return None;
             }
+            if !near(&yr, y, r.floor(c)) {
+                far.push(j);
+            }
             out.push((yr, wy));
+        }
+        if !far.is_empty() {
+            let c = self.consts();
+            let rhs = self.basis_rhs(&cur.classes)?;
+            let cols: Vec<&[f64]> = far.iter().map(|&j| &out[j].0[..]).collect();
+            let wys = mat_mul(problem.delassus().w(), &cols);
+            let rb = self.row_bound();
+            for (&j, wy) in far.iter().zip(&wys) {
+                let (y, b) = (&out[j].0, &rhs[j]);
+                let res = update::residual_rows(&c, &cur.classes, y, wy, b);
+                let rel = update::relative_residual(&c, &cur.classes, &res, y, b, rb);
+                if rel.is_nan() || rel > 1e-12 {
+                    return None;
+                }
+            }
         }
         Some(out)
     }
