@@ -976,6 +976,38 @@ fn start_on_an_extremely_slender_strip() {
     );
 }
 
+/// A contact front closing node by node along a slender strip (801 × 5 on 103.28 ×
+/// 0.245, F = 3, κ(W) 5e10, extended precision), its free end touching down now and then
+/// ahead of it. At each of those touchdowns the gap of the front's next node was 6.2e-14,
+/// 1.4e-14 of its terms and a hundredth of its threshold, with its own root 1e-5 later in
+/// α: counted at zero, that node touched down together with the free-end node, 30 times
+/// over, each 1e-5 to 4e-5 in α early and without an error, until a node fit no class
+/// (α = −0.97111). Against the reference on [−0.975, −0.965].
+#[test]
+fn a_closing_front_does_not_take_its_next_node_along_with_a_touchdown_elsewhere() {
+    let spec = RectSpec {
+        nx: 801,
+        ny: 5,
+        lx: 103.28,
+        ly: 0.245,
+        friction: 3.0,
+        load0: vec![
+            Traction::linear(Side::Top, [0.00038, -0.00804], [-0.00812, -0.0076]),
+            Traction::uniform(Side::Right, [0.00927, -0.00788]),
+        ],
+        load1: vec![Traction::linear(
+            Side::Top,
+            [0.00762, -0.00736],
+            [0.00518, -0.00786],
+        )],
+        alpha_start: -0.975,
+        alpha_end: -0.965,
+        ..RectSpec::default()
+    };
+    let c = checked_against_reference("front 801 x 5", &spec, 1e-8);
+    assert!(c.fricont.len() >= 60, "{} events", c.fricont.len());
+}
+
 /// How far the state's λ lies from the reference's piece of its classes at the affine
 /// load's parameter `s` (max |Δλ| / max |λ_ref|).
 fn off_reference(cond: &Condensed, st: &fricont::path::State, s: f64) -> f64 {
@@ -1242,9 +1274,11 @@ fn auto_refines_an_ill_conditioned_w_over_the_cost_budget() {
 }
 
 /// A basis load entering a steep piece after a fold (extended precision, auto): a
-/// 401 × 5 strip on (0, 40) × (0, 0.12) with F = 5 (κ(W) = 1e10), whose affine path (1627
-/// events over its window, every piece end valid from the data: SuperLU with long-double
-/// residuals, to 1.6e-10 of its scales) folds at α = 1.5359 onto a piece 4e-6 long whose
+/// 401 × 5 strip on (0, 40) × (0, 0.12) with F = 5 (κ(W) = 1e10), whose affine path (1637
+/// events over its window, the reference tracer's; it had 1627, every piece end valid
+/// from the data by SuperLU with long-double residuals, but three events 3e-5 apart in α
+/// at α = 1.5514 merged into one, see `join::transit`) folds at α = 1.5359 onto a piece
+/// 4e-6 long whose
 /// M_S is nearly singular. The same load as a basis load with weights (1, α), and
 /// reparametrised by the increasing `φ(α) = α + A sin(ω α)` (events at `φ(α_k)` the
 /// affine ones), must give the affine events. Before, the basis load's march evaluated

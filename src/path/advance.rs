@@ -222,21 +222,7 @@ impl Path {
     /// the path's factorisation. None for other loads, for the fresh-factorisation tracer
     /// (which keeps solving at every α, the reference), or when a solve fails its check.
     fn basis_solutions(&mut self, cur: &CurrentPiece) -> Option<BasisSolutions> {
-        let PieceSolver::Updated(u) = &*cur.lu else {
-            return None;
-        };
-        let rhs = self.basis_rhs(&cur.classes)?;
-        // Carried by the updates to this piece and checked from the data when its tangent
-        // was computed (Path::tangent_updated): nothing to solve.
-        let (y, wy) = match u.checked().filter(|k| k.0.len() == rhs.len()) {
-            Some(k) => Arc::unwrap_or_clone(k),
-            None => u.solve_cols(
-                &self.consts(),
-                self.problem.delassus().w(),
-                &rhs,
-                self.row_bound(),
-            )?,
-        };
+        let (y, wy) = self.basis_solves(cur)?;
         Some(match self.refine_basis(cur, &y) {
             Some(r) => {
                 let (y, wy) = r.into_iter().unzip();
@@ -252,6 +238,26 @@ impl Path {
                 refined: false,
             },
         })
+    }
+
+    /// The basis solutions `y_j` of the current piece (see [`BasisSolutions`]) in double,
+    /// with `W y_j`: carried by the updates to this piece and checked from the data when
+    /// its tangent was computed (`Path::tangent_updated`), else solved for. None for a
+    /// piece not solved by updates, or when a solve fails its check.
+    pub(super) fn basis_solves(&self, cur: &CurrentPiece) -> Option<update::CheckedCols> {
+        let PieceSolver::Updated(u) = &*cur.lu else {
+            return None;
+        };
+        let rhs = self.basis_rhs(&cur.classes)?;
+        match u.checked().filter(|k| k.0.len() == rhs.len()) {
+            Some(k) => Some(Arc::unwrap_or_clone(k)),
+            None => u.solve_cols(
+                &self.consts(),
+                self.problem.delassus().w(),
+                &rhs,
+                self.row_bound(),
+            ),
+        }
     }
 
     /// The point `(λ, d)` of the current piece at α from the guess `lam` (the basis

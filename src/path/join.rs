@@ -201,6 +201,7 @@ impl Path {
                 continue;
             }
             let c = self.consts();
+            let resolved = self.resolved.borrow();
             // None: the guard lets the direction in; Some(at zero): it does not.
             let blocks = |row: &GuardRow| -> Option<bool> {
                 let (v, vd) = (row.value, s * row.slope);
@@ -208,6 +209,10 @@ impl Path {
                 // increase: its slope (force per unit of scaled arclength) against the
                 // scale of the point.
                 let form = c.guard_form(row.guard);
+                // (positive, its root a distinct step away in double-double: see `transit`)
+                if v > 0.0 && resolved.contains(&row.guard) {
+                    return None;
+                }
                 let tol_row = if switching.contains(&row.guard.node) {
                     &tol_switching
                 } else {
@@ -414,11 +419,25 @@ impl Path {
         pt: Point,
         crossing: Vec<Guard>,
     ) -> Result<StepOutcome> {
+        let out = self.transit_at(cur, pt, crossing);
+        self.resolved.borrow_mut().clear();
+        out
+    }
+
+    /// [`Self::transit`], which clears the point's resolved guards after it.
+    fn transit_at(
+        &mut self,
+        cur: CurrentPiece,
+        pt: Point,
+        crossing: Vec<Guard>,
+    ) -> Result<StepOutcome> {
         let tol = self.tol_at(&pt);
         let c = self.consts();
         let mut nodes: Vec<usize> = crossing.iter().map(|g| g.node).collect();
         // Guards at zero (Tol::at_zero, with their slopes along the way the path came):
         // the nodes switching at this point together with the crossing one.
+        let mut by_value = Vec::new();
+        let mut resolved = Vec::new();
         for GuardRow {
             guard: g,
             value: v,
@@ -427,11 +446,57 @@ impl Path {
         {
             let form = c.guard_form(g);
             if v <= 0.0 || tol.at_zero(&form, v, vd) {
-                nodes.push(g.node);
+                if v > 0.0 && vd < 0.0 && v > tol.arc * -vd {
+                    by_value.push((g, form));
+                } else {
+                    nodes.push(g.node);
+                }
+            }
+        }
+        // A positive guard approaching zero that is at zero by its value only (within its
+        // rounding in double, not crossing within zero_tol along the tangent): where the
+        // piece is carried in double-double (an affine or basis load in extended
+        // precision), its own root on the refined line (a basis load's: one Newton step on
+        // its refined solutions) decides. One more than ROUNDING_LONG of α's unit away is
+        // its own transition, later: its node does not switch here, and the candidate
+        // pieces take the guard as inside (`resolved`, see `push_candidates`). On a slender
+        // strip (801 × 5 on 103 × 0.245, F = 3, κ(W) 5e10) the gap of the next node of a
+        // closing front was 6.2e-14 (1.4e-14 of its terms, a hundredth of its threshold)
+        // where a node at the free end touched down, its root 1e-5 later in α: it touched
+        // down there with it, 30 times over, each 1e-5 to 4e-5 early (the reference tracer
+        // has every touchdown on its own), until a node fit no class. On a 401 × 5 strip
+        // (F = 5) three events, 3e-5 in α apart in the reference, were one.
+        if !by_value.is_empty() {
+            let forms: Vec<crate::piece::LinForm> = by_value.iter().map(|(_, f)| *f).collect();
+            let roots = if !self.problem.extended_precision() {
+                None
+            } else if self.load.is_affine() {
+                self.refined_roots(&cur, &forms)
+            } else if self.load.basis_vectors().is_some() {
+                self.refined_basis_roots(&cur, pt.alpha, &forms)
+            } else {
+                None
+            };
+            // (in the unit of α over which the load changes by the point's force scale: not
+            // relative to α itself, which a translated α axis makes large)
+            let apart = ROUNDING_LONG * self.alpha_unit(&pt, self.force_scale(&pt));
+            for (k, (guard, _)) in by_value.into_iter().enumerate() {
+                let node = guard.node;
+                let own = roots
+                    .as_ref()
+                    .and_then(|r| r[k])
+                    .is_some_and(|a| (a - pt.alpha).abs() > apart);
+                if own {
+                    resolved.push(guard);
+                } else {
+                    nodes.push(node);
+                }
             }
         }
         nodes.sort_unstable();
         nodes.dedup();
+        // (for the candidates of this point only)
+        *self.resolved.borrow_mut() = resolved;
         let entry = self.point_at(cur.lam.clone(), cur.alpha)?;
         let pt = self.snap_to_vertex(pt, &tol, &entry, &cur.classes, &crossing)?;
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));

@@ -259,6 +259,9 @@ pub struct Path {
     /// The last step (α units) that the march of a nonlinear load trusted: the next
     /// piece's march starts from twice that, not from the window's scale.
     graph_step: Cell<Option<f64>>,
+    /// Guards that the current transition point found positive in double-double though
+    /// within their thresholds (see `join::transit`): they let a candidate piece in.
+    resolved: RefCell<Vec<crate::piece::Guard>>,
 }
 
 /// The traced data and the current position.
@@ -938,6 +941,7 @@ impl Path {
             tol_cache: PointCache::new(),
             scale_cache: PointCache::new(),
             graph_step: Cell::new(None),
+            resolved: RefCell::new(Vec::new()),
         })
     }
 

@@ -600,6 +600,81 @@ impl Path {
             })
     }
 
+    /// In extended precision, the α where each of `forms` (guards of the straight piece
+    /// `cur`) reaches zero on the piece's line refined in double-double (`λ_e + (α − α_e)
+    /// λ'`, its d likewise), rounded to double: None for a form constant along the piece.
+    /// None (for all) as for [`Self::refine_piece`].
+    pub(super) fn refined_roots(
+        &mut self,
+        cur: &CurrentPiece,
+        forms: &[LinForm],
+    ) -> Option<Vec<Option<f64>>> {
+        let r = self.refine_piece(cur)?;
+        Some(
+            forms
+                .iter()
+                .map(|f| {
+                    let v = eval_dd(f, &r.lam_e, &r.d_e);
+                    let slope = eval_dd(f, &r.lam_1, &r.d_1);
+                    let alpha = (-v).div(slope).add_f64(cur.alpha).to_f64();
+                    (slope.hi != 0.0 && alpha.is_finite()).then_some(alpha)
+                })
+                .collect(),
+        )
+    }
+
+    /// [`Self::refined_roots`] under a basis load: each form's value and slope at `alpha`
+    /// on the piece from its basis solutions refined in double-double (`Σ_j w_j G_j + G_g`
+    /// and `Σ_j w'_j G_j`, G the form on each solution), and its root one Newton step
+    /// from `alpha`, rounded to double. None (for all) where the solutions are not
+    /// refined.
+    pub(super) fn refined_basis_roots(
+        &mut self,
+        cur: &CurrentPiece,
+        alpha: f64,
+        forms: &[LinForm],
+    ) -> Option<Vec<Option<f64>>> {
+        let (ys, _) = self.basis_solves(cur)?;
+        let problem = self.problem.clone();
+        let r = self.refiner(&problem, &cur.classes, cur.lu.updated())?;
+        let k = r.q.len();
+        if ys.len() != k + 1 {
+            return None;
+        }
+        let pairs: Vec<(DdVec, DdVec)> = ys
+            .iter()
+            .enumerate()
+            .map(|(j, y)| {
+                let mut e = vec![0.0; k];
+                if j < k {
+                    e[j] = 1.0;
+                }
+                (DdVec::from(y), r.basis_constant(&e, j == k))
+            })
+            .collect();
+        let refined = r.refine_all(pairs)?;
+        let (w, dw) = self.load.weights_at(alpha)?;
+        Some(
+            forms
+                .iter()
+                .map(|f| {
+                    let (mut v, mut slope) = (Dd::ZERO, Dd::ZERO);
+                    for (j, (x, d)) in refined.iter().enumerate() {
+                        let g = eval_dd(f, x, d);
+                        if j < k {
+                            v = v + g.mul_f64(w[j]);
+                            slope = slope + g.mul_f64(dw[j]);
+                        } else {
+                            v = v + g;
+                        }
+                    }
+                    let root = alpha + (-v).div(slope).to_f64();
+                    (slope.hi != 0.0 && root.is_finite()).then_some(root)
+                })
+                .collect(),
+        )
+    }
+
     /// The exit of the refined straight piece `r` of `cur` through the first of
     /// `decreasing` to reach zero, in double-double: `(λ, α, guard)` rounded to double.
     /// None when no guard of `decreasing` decreases in double-double or the exit lies
