@@ -174,6 +174,25 @@ impl Refiner<'_> {
         out
     }
 
+    /// Each of a basis load's solutions `ys` (`y_1 … y_J, y_g`, see [`Path::refine_basis`])
+    /// with the constant of its d: `q_j`, and the gap's `−(g, 0)` for `y_g`. None where
+    /// `ys` is not one per basis vector and one for the gap.
+    fn basis_pairs(&self, ys: &[Vec<f64>]) -> Option<Vec<(DdVec, DdVec)>> {
+        let k = self.q.len();
+        (ys.len() == k + 1).then(|| {
+            ys.iter()
+                .enumerate()
+                .map(|(j, y)| {
+                    let mut e = vec![0.0; k];
+                    if j < k {
+                        e[j] = 1.0;
+                    }
+                    (DdVec::from(y), self.basis_constant(&e, j == k))
+                })
+                .collect()
+        })
+    }
+
     /// The constant of d's rate: `q1` in double-double.
     fn rate_constant(&self) -> DdVec {
         let (q1, q1_lo) = &self.q[1];
@@ -443,21 +462,7 @@ impl Path {
         let problem = self.problem.clone();
         let r = self.refiner(&problem, &cur.classes, cur.lu.updated())?;
         let k = r.q.len();
-        if ys.len() != k + 1 {
-            return None;
-        }
-        let pairs: Vec<(DdVec, DdVec)> = ys
-            .iter()
-            .enumerate()
-            .map(|(j, y)| {
-                let mut e = vec![0.0; k];
-                let gap = j == k;
-                if !gap {
-                    e[j] = 1.0;
-                }
-                (DdVec::from(y), r.basis_constant(&e, gap))
-            })
-            .collect();
+        let pairs = r.basis_pairs(ys)?;
         let consts: Vec<DdVec> = pairs.iter().map(|(_, c)| c.clone()).collect();
         let refined = r.refine_all(pairs)?;
         let mut out = Vec::with_capacity(k + 1);
@@ -638,21 +643,7 @@ impl Path {
         let problem = self.problem.clone();
         let r = self.refiner(&problem, &cur.classes, cur.lu.updated())?;
         let k = r.q.len();
-        if ys.len() != k + 1 {
-            return None;
-        }
-        let pairs: Vec<(DdVec, DdVec)> = ys
-            .iter()
-            .enumerate()
-            .map(|(j, y)| {
-                let mut e = vec![0.0; k];
-                if j < k {
-                    e[j] = 1.0;
-                }
-                (DdVec::from(y), r.basis_constant(&e, j == k))
-            })
-            .collect();
-        let refined = r.refine_all(pairs)?;
+        let refined = r.refine_all(r.basis_pairs(&ys)?)?;
         let (w, dw) = self.load.weights_at(alpha)?;
         Some(
             forms
