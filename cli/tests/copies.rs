@@ -13,10 +13,6 @@ use fricont::{Class, CsrMatrix, ExtendedPrecision};
 use fricont_exchange::generator::{RectSpec, Side, Traction, generate};
 use fricont_exchange::io::CaseData;
 
-fn traction(side: Side, start: [f64; 2], end: [f64; 2]) -> Traction {
-    Traction { side, start, end }
-}
-
 fn triplets(m: &CsrMatrix) -> Vec<(usize, usize, f64)> {
     (0..m.nrows())
         .flat_map(|i| {
@@ -41,18 +37,18 @@ fn stacked_blocks(lower_first: bool, row_scale: impl Fn(usize) -> f64) -> CaseDa
         lx: 9.281508251795191,
         ly: 0.4313436809796125,
         friction: 0.1,
-        load0: vec![traction(
+        load0: vec![Traction::linear(
             Side::Top,
             [-0.0031280231741008515, -0.018972913400191492],
             [0.0016612436658990423, -0.002295441973289944],
         )],
         load1: vec![
-            traction(
+            Traction::linear(
                 Side::Top,
                 [-0.0011969129202796976, -0.006948103893735149],
                 [-0.008266070711862382, 0.008245908828772132],
             ),
-            traction(
+            Traction::linear(
                 Side::Right,
                 [0.0023210048606749287, -0.003146560480008255],
                 [-0.004986381685156808, 0.0005751694676886564],
@@ -64,12 +60,12 @@ fn stacked_blocks(lower_first: bool, row_scale: impl Fn(usize) -> f64) -> CaseDa
         ny: 6,
         ly: 2.6909046827182186,
         e: 2.503782705785187,
-        load0: vec![traction(
+        load0: vec![Traction::linear(
             Side::Right,
             [0.0009910265554538104, -0.00039498816627083725],
             [0.0007141119826645805, 0.0003236284444737079],
         )],
-        load1: vec![traction(
+        load1: vec![Traction::linear(
             Side::Right,
             [0.001634306003851073, -0.0017776890361044337],
             [-0.001673312429293632, -0.0014423844254738],
@@ -241,10 +237,10 @@ fn a_thin_strip_near_its_folds_agrees_with_its_row_scaled_copy() {
         alpha_start: -1.704,
         alpha_end: 2.0,
         load0: vec![
-            traction(Side::Top, [-0.00833, -0.00732], [-0.00339, -0.00489]),
-            traction(Side::Right, [-0.00154, -0.00437], [-0.00154, -0.00437]),
+            Traction::linear(Side::Top, [-0.00833, -0.00732], [-0.00339, -0.00489]),
+            Traction::uniform(Side::Right, [-0.00154, -0.00437]),
         ],
-        load1: vec![traction(
+        load1: vec![Traction::linear(
             Side::Top,
             [-0.00249, -0.00526],
             [-0.00781, 0.0006],

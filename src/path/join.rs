@@ -481,7 +481,6 @@ impl Path {
             // relative to α itself, which a translated α axis makes large)
             let apart = ROUNDING_LONG * self.alpha_unit(&pt, self.force_scale(&pt));
             for (k, (guard, _)) in by_value.into_iter().enumerate() {
-                let node = guard.node;
                 let own = roots
                     .as_ref()
                     .and_then(|r| r[k])
@@ -489,7 +488,7 @@ impl Path {
                 if own {
                     resolved.push(guard);
                 } else {
-                    nodes.push(node);
+                    nodes.push(guard.node);
                 }
             }
         }
