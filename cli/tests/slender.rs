@@ -1008,6 +1008,63 @@ fn a_closing_front_does_not_take_its_next_node_along_with_a_touchdown_elsewhere(
     assert!(c.fricont.len() >= 60, "{} events", c.fricont.len());
 }
 
+/// Guards at zero by their value only at another node's transition, whose own roots lie
+/// apart in double-double (extended precision, against the reference): a node that had
+/// opened 1.9e-5 before in α (401 × 5 on 40 × 0.12, F = 5), its gap still increasing,
+/// closed again where its neighbour opened, 4.2e-6 before its own root (it was then
+/// reported as a bifurcation); on a thinner strip (180 × 8 on 2.48 × 0.059, F = 0.1, a
+/// uniform gap) a node stuck together with another whose root lay 2.3e-8 before its own
+/// (1e-9 of α's unit: within the 1e-8 of the unit first allowed).
+#[test]
+fn a_node_switches_at_its_own_root_where_double_double_resolves_its_guard() {
+    let opened = RectSpec {
+        nx: 401,
+        ny: 5,
+        lx: 40.0,
+        ly: 0.12,
+        friction: 5.0,
+        load0: vec![Traction::linear(
+            Side::Top,
+            [0.00284, -0.02839],
+            [-0.00918, -0.01348],
+        )],
+        load1: vec![Traction::linear(
+            Side::Top,
+            [-0.00293, -0.00424],
+            [0.00754, 0.00933],
+        )],
+        alpha_start: 1.515,
+        alpha_end: 1.516,
+        ..RectSpec::default()
+    };
+    let c = checked_against_reference("node reopening 401 x 5", &opened, 1e-8);
+    assert_eq!(c.fricont.len(), 3, "{:?}", c.fricont);
+    // (the digits of a sweep's random draw)
+    let sticking = RectSpec {
+        nx: 180,
+        ny: 8,
+        lx: 2.476807339585812,
+        ly: 0.05934930486784456,
+        friction: 0.1,
+        gap: 0.00018179554557705554,
+        load0: vec![Traction::linear(
+            Side::Top,
+            [0.0023935407366998795, -0.0054138029732733045],
+            [0.0023990940512485653, -0.02207050544818246],
+        )],
+        load1: vec![Traction::linear(
+            Side::Top,
+            [0.0043479476173950565, 0.00956002070660446],
+            [0.005277856882268601, -0.0022597541767041185],
+        )],
+        alpha_start: -0.828,
+        alpha_end: -0.8279,
+        ..RectSpec::default()
+    };
+    let c = checked_against_reference("sticking 180 x 8", &sticking, 1e-8);
+    assert_eq!(c.fricont.len(), 7, "{:?}", c.fricont);
+}
+
 /// How far the state's λ lies from the reference's piece of its classes at the affine
 /// load's parameter `s` (max |Δλ| / max |λ_ref|).
 fn off_reference(cond: &Condensed, st: &fricont::path::State, s: f64) -> f64 {

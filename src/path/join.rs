@@ -446,20 +446,23 @@ impl Path {
         {
             let form = c.guard_form(g);
             if v <= 0.0 || tol.at_zero(&form, v, vd) {
-                if v > 0.0 && vd < 0.0 && v > tol.arc * -vd {
+                if v > 0.0 && v > tol.arc * vd.abs() {
                     by_value.push((g, form));
                 } else {
                     nodes.push(g.node);
                 }
             }
         }
-        // A positive guard approaching zero that is at zero by its value only (within its
-        // rounding in double, not crossing within zero_tol along the tangent): where the
-        // piece is carried in double-double (an affine or basis load in extended
-        // precision), its own root on the refined line (a basis load's: one Newton step on
-        // its refined solutions) decides. One more than ROUNDING_LONG of α's unit away is
-        // its own transition, later: its node does not switch here, and the candidate
-        // pieces take the guard as inside (`resolved`, see `push_candidates`). On a slender
+        // A positive guard that is at zero by its value only (within its rounding in
+        // double, not crossing within zero_tol along the tangent): where the piece is
+        // carried in double-double (an affine or basis load in extended precision), its
+        // own root on the refined line (a basis load's: one Newton step on its refined
+        // solutions) decides. One more than RESOLVED_APART of α's unit away, ahead (its own
+        // transition, later) or behind (its node switched a step before), the guard is
+        // positive here: its node does not switch, and the candidate pieces take the guard
+        // as inside (`resolved`, see `push_candidates`). On a 401 × 5 strip (F = 5) a node
+        // that had opened 1.9e-5 before in α, its gap still increasing, closed again where
+        // its neighbour opened, 4.2e-6 before its own root (the reference tracer's). On a slender
         // strip (801 × 5 on 103 × 0.245, F = 3, κ(W) 5e10) the gap of the next node of a
         // closing front was 6.2e-14 (1.4e-14 of its terms, a hundredth of its threshold)
         // where a node at the free end touched down, its root 1e-5 later in α: it touched
@@ -479,7 +482,7 @@ impl Path {
             };
             // (in the unit of α over which the load changes by the point's force scale: not
             // relative to α itself, which a translated α axis makes large)
-            let apart = ROUNDING_LONG * self.alpha_unit(&pt, self.force_scale(&pt));
+            let apart = RESOLVED_APART * self.alpha_unit(&pt, self.force_scale(&pt));
             for (k, (guard, _)) in by_value.into_iter().enumerate() {
                 let own = roots
                     .as_ref()

@@ -376,6 +376,14 @@ const ROUNDING: f64 = 1e-2;
 /// it at zero by its value where the thresholds are estimated.
 const ROUNDING_LONG: f64 = 1e-8;
 
+/// How near its own root, on a piece refined in double-double, a guard at zero by its value
+/// only must lie for `join::transit` to switch its node at a transition point: in α's unit
+/// (the change of α that moves the load by the point's force scale). Such roots are
+/// resolved far below [`ROUNDING_LONG`]: on a strip (180 × 8 on 2.48 × 0.059, F = 0.1,
+/// α's unit 25) two nodes' stick roots lay 2.3e-8 apart in α, 1e-9 of the unit, and
+/// were one transition with 1e-8.
+const RESOLVED_APART: f64 = 1e-10;
+
 /// Most that the window's length counts for a nonlinear load's march beyond the point's
 /// own α length (see [`Path::load_span`]): windows up to a thousand times that scale
 /// march as the window's length says (the suites' windows, and far windows up to 1e3 of
