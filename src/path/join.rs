@@ -457,18 +457,18 @@ impl Path {
         // double, not crossing within zero_tol along the tangent): where the piece is
         // carried in double-double (an affine or basis load in extended precision), its
         // own root on the refined line (a basis load's: one Newton step on its refined
-        // solutions) decides. One more than RESOLVED_APART of α's unit away, ahead (its own
-        // transition, later) or behind (its node switched a step before), the guard is
-        // positive here: its node does not switch, and the candidate pieces take the guard
-        // as inside (`resolved`, see `push_candidates`). On a 401 × 5 strip (F = 5) a node
-        // that had opened 1.9e-5 before in α, its gap still increasing, closed again where
-        // its neighbour opened, 4.2e-6 before its own root (the reference tracer's). On a slender
-        // strip (801 × 5 on 103 × 0.245, F = 3, κ(W) 5e10) the gap of the next node of a
+        // solutions) decides. One more than RESOLVED_APART of α's unit away, ahead (its
+        // own transition, later) or behind (its node switched a step before), the guard is
+        // positive here: its node does not switch, and the candidate pieces take the
+        // guard as inside (`resolved`, see `push_candidates`). On a slender strip
+        // (801 × 5 on 103 × 0.245, F = 3, κ(W) 5e10) the gap of the next node of a
         // closing front was 6.2e-14 (1.4e-14 of its terms, a hundredth of its threshold)
         // where a node at the free end touched down, its root 1e-5 later in α: it touched
         // down there with it, 30 times over, each 1e-5 to 4e-5 early (the reference tracer
         // has every touchdown on its own), until a node fit no class. On a 401 × 5 strip
-        // (F = 5) three events, 3e-5 in α apart in the reference, were one.
+        // (F = 5) three events, 3e-5 in α apart in the reference, were one; and a node
+        // that had opened 1.9e-5 before in α, its gap still increasing, closed again where
+        // its neighbour opened, 4.2e-6 before its own root (the reference's).
         if !by_value.is_empty() {
             let forms: Vec<crate::piece::LinForm> = by_value.iter().map(|(_, f)| *f).collect();
             let roots = if !self.problem.extended_precision() {
