@@ -371,7 +371,7 @@ pub enum Storage {
 pub enum ExtendedPrecision {
     /// Refine when it is cheap, or when W is ill-conditioned and refining is affordable:
     /// the refinement's estimated floating-point operations (about `2p · (16 nnz(L) + 36
-    /// nnz(A))`) are at most [`AUTO_SMALL_FLOPS`] (2e8, about 0.05 s on one core), or the
+    /// nnz(A))`) are at most [`AUTO_SMALL_FLOPS`] (2e9, about 0.1 s on one core), or the
     /// estimate [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e6) and
     /// they are at most `max(20 × the factorisation's, 1e11)` ([`AUTO_COST_FLOPS`]: about
     /// 10 s on one core), or, whatever they cost, where the estimate exceeds
@@ -427,15 +427,20 @@ pub const AUTO_COST_RATIO: f64 = 20.0;
 pub const AUTO_COST_FLOPS: f64 = 1e11;
 
 /// [`ExtendedPrecision::Auto`] refines whatever W's condition where the refinement's
-/// estimated floating-point operations are at most this (2e8, about 0.05 s on one core:
-/// the repository's sample, n = 1320 and p = 30, is below it; a 121 × 81 rectangle with
-/// p = 120 is not). Even a
+/// estimated floating-point operations are at most this (2e9: 0.06–0.1 s on this
+/// project's machine for rectangles of 20–200 × 2–12 nodes, where the estimate ran at
+/// about 3e10 per second; the repository's sample, n = 1320 and p = 30, is below it; a
+/// 121 × 81 rectangle with p = 120 is not). Even a
 /// well-conditioned W, condensed in double, carries errors of κ(A) ε in its entries, and
 /// transitions where a guard crosses zero at a shallow angle amplify them and the
 /// trace's own rounding: on finite-element meshes of 12 to 37 × 1 to 3 elements with
 /// κ(W) ≈ 1e3–1e4, events in double were off by up to 5.5e-12 relative (against a
-/// double-double reference), and by at most 8.6e-13 refined and traced in double-double.
-pub const AUTO_SMALL_FLOPS: f64 = 2e8;
+/// double-double reference), and by at most 8.6e-13 refined and traced in double-double;
+/// on 400 random rectangles (20–200 × 2–12 nodes, κ(W) 3e3–1e6 where `auto` left them in
+/// double) 55 of the 330 traced in double were off by more than 1e-11 in α (up to 1.3e-9
+/// at κ(W) 5e5–1e6) against the independent reference of `tests/common/reference.rs`.
+/// (It was 2e8, "about 0.05 s", which ran in 0.01 s.)
+pub const AUTO_SMALL_FLOPS: f64 = 2e9;
 
 /// Where the operator `A⁻¹` and `W` come from.
 #[derive(Debug, Clone)]
