@@ -436,10 +436,12 @@ pub const AUTO_COST_FLOPS: f64 = 1e11;
 /// trace's own rounding: on finite-element meshes of 12 to 37 × 1 to 3 elements with
 /// κ(W) ≈ 1e3–1e4, events in double were off by up to 5.5e-12 relative (against a
 /// double-double reference), and by at most 8.6e-13 refined and traced in double-double;
-/// on 400 random rectangles (20–200 × 2–12 nodes, κ(W) 3e3–1e6 where `auto` left them in
-/// double) 55 of the 330 traced in double were off by more than 1e-11 in α (up to 1.3e-9
-/// at κ(W) 5e5–1e6) against the independent reference of `tests/common/reference.rs`.
-/// (It was 2e8, "about 0.05 s", which ran in 0.01 s.)
+/// on 400 random rectangles (20–200 × 2–12 nodes) against the independent reference of
+/// `tests/common/reference.rs`, 55 of the 150 that 2e8 left in double (κ(W) 3e3–1e6) were
+/// off by more than 1e-11 in α, up to 1.3e-9; refined, all agree to 2.7e-16. This budget
+/// refines 111 of those 150, 40 of the 55 among them; the other 15 (refinements of
+/// 2.1e9–5.4e9 flops, up to 0.21 s) stay in double. (It was 2e8, "about 0.05 s", which ran
+/// in 0.01 s.)
 pub const AUTO_SMALL_FLOPS: f64 = 2e9;
 
 /// Where the operator `A⁻¹` and `W` come from.
