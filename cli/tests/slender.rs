@@ -744,6 +744,32 @@ fn basis_along(
         .expect("basis load")
 }
 
+/// A 401 × 5 strip on (0, 40) × (0, 0.12), F = 5, κ(W) = 1e10, pressed and sheared on
+/// top, window [−2, 2]: its path folds often (see
+/// `basis_load_entering_a_steep_piece_after_a_fold`).
+fn folding_strip() -> RectSpec {
+    RectSpec {
+        nx: 401,
+        ny: 5,
+        lx: 40.0,
+        ly: 0.12,
+        friction: 5.0,
+        load0: vec![Traction::linear(
+            Side::Top,
+            [0.00284, -0.02839],
+            [-0.00918, -0.01348],
+        )],
+        load1: vec![Traction::linear(
+            Side::Top,
+            [-0.00293, -0.00424],
+            [0.00754, 0.00933],
+        )],
+        alpha_start: -2.0,
+        alpha_end: 2.0,
+        ..RectSpec::default()
+    }
+}
+
 /// The thin strip of `cli/benches/strips.rs`: `p + 1 × 4` nodes on `(0, p/40) × (0, 0.1)`.
 fn strip(p: usize) -> RectSpec {
     RectSpec {
@@ -1018,24 +1044,9 @@ fn a_closing_front_does_not_take_its_next_node_along_with_a_touchdown_elsewhere(
 #[test]
 fn a_node_switches_at_its_own_root_where_double_double_resolves_its_guard() {
     let opened = RectSpec {
-        nx: 401,
-        ny: 5,
-        lx: 40.0,
-        ly: 0.12,
-        friction: 5.0,
-        load0: vec![Traction::linear(
-            Side::Top,
-            [0.00284, -0.02839],
-            [-0.00918, -0.01348],
-        )],
-        load1: vec![Traction::linear(
-            Side::Top,
-            [-0.00293, -0.00424],
-            [0.00754, 0.00933],
-        )],
         alpha_start: 1.515,
         alpha_end: 1.516,
-        ..RectSpec::default()
+        ..folding_strip()
     };
     let c = checked_against_reference("node reopening 401 x 5", &opened, 1e-8);
     assert_eq!(c.fricont.len(), 3, "{:?}", c.fricont);
@@ -1350,12 +1361,7 @@ fn auto_refines_an_ill_conditioned_w_over_the_cost_budget() {
 /// class"): the third load.
 #[test]
 fn basis_load_entering_a_steep_piece_after_a_fold() {
-    let case = rect_case(
-        r#"{"nx": 401, "ny": 5, "lx": 40.0, "ly": 0.12, "friction": 5.0,
-            "load0": [{"side": "top", "start": [0.00284, -0.02839], "end": [-0.00918, -0.01348]}],
-            "load1": [{"side": "top", "start": [-0.00293, -0.00424], "end": [0.00754, 0.00933]}],
-            "alpha_start": -2.0, "alpha_end": 2.0}"#,
-    );
+    let case = generate(&folding_strip()).expect("generate");
     let problem = Arc::new(case.problem(None).expect("problem"));
     assert!(problem.extended_precision());
     let (a0, a1) = (case.alpha_start, case.alpha_end);
