@@ -881,10 +881,11 @@ pub unsafe extern "C" fn fricont_problem_set_threads(
 /// the build, and 2p × 2p more doubles of memory). Auto refines where the refinement is
 /// cheap (at most 2e9 floating-point operations, about 0.1 s: small problems, whose
 /// events then carry about 1e-14 instead of 1e-12 to 1e-9 relative error), and where an
-/// estimate of the 2-norm condition number of the equilibrated W exceeds 1e6 and the refinement's
-/// estimated cost is at most max(20 × the factorisation's, 1e11 floating-point
-/// operations), or whatever it costs where that estimate exceeds 1e8 (there double's
-/// rounding moved a transition of a slender strip by 4.3e-3 in α); off never. A problem
+/// estimate of the 2-norm condition number of the equilibrated W exceeds 1e6 and the
+/// refinement's estimated cost is at most max(20 × the factorisation's, 1e11
+/// floating-point operations), or whatever it costs where that estimate exceeds 1e8
+/// (there double's rounding moved a transition of a slender strip by 4.3e-3 in α); off
+/// never. A problem
 /// made from condensed data (`fricont_problem_new_condensed`) is never refined (its W is
 /// the caller's data); with on (or auto and an ill-conditioned W) it is traced in
 /// extended precision all the same. Like the friction, a change drops the factorisation:
