@@ -371,7 +371,7 @@ pub enum Storage {
 pub enum ExtendedPrecision {
     /// Refine when it is cheap, or when W is ill-conditioned and refining is affordable:
     /// the refinement's estimated floating-point operations (about `2p · (16 nnz(L) + 36
-    /// nnz(A))`) are at most [`AUTO_SMALL_FLOPS`] (2e9, about 0.1 s on one core), or the
+    /// nnz(A))`) are at most [`AUTO_SMALL_FLOPS`] (6e9, about 0.3 s on one core), or the
     /// estimate [`Problem::w_condition_estimate`] exceeds [`AUTO_CONDITION`] (1e6) and
     /// they are at most `max(20 × the factorisation's, 1e11)` ([`AUTO_COST_FLOPS`]: about
     /// 10 s on one core), or, whatever they cost, where the estimate exceeds
@@ -427,9 +427,9 @@ pub const AUTO_COST_RATIO: f64 = 20.0;
 pub const AUTO_COST_FLOPS: f64 = 1e11;
 
 /// [`ExtendedPrecision::Auto`] refines whatever W's condition where the refinement's
-/// estimated floating-point operations are at most this (2e9: 0.06–0.1 s on this
+/// estimated floating-point operations are at most this (6e9: up to about 0.3 s on this
 /// project's machine for rectangles of 20–200 × 2–12 nodes, where the estimate ran at
-/// about 3e10 per second; the repository's sample, n = 1320 and p = 30, is below it; a
+/// 1.3e10–5e10 per second; the repository's sample, n = 1320 and p = 30, is below it; a
 /// 121 × 81 rectangle with p = 120 is not). Even a
 /// well-conditioned W, condensed in double, carries errors of κ(A) ε in its entries, and
 /// transitions where a guard crosses zero at a shallow angle amplify them and the
@@ -439,10 +439,11 @@ pub const AUTO_COST_FLOPS: f64 = 1e11;
 /// on 400 random rectangles (20–200 × 2–12 nodes) against the independent reference of
 /// `tests/common/reference.rs`, 55 of the 150 that 2e8 left in double (κ(W) 3e3–1e6) were
 /// off by more than 1e-11 in α, up to 1.3e-9; refined, all agree to 2.7e-16. This budget
-/// refines 111 of those 150, 40 of the 55 among them; the other 15 (refinements of
-/// 2.1e9–5.4e9 flops, up to 0.21 s) stay in double. (It was 2e8, "about 0.05 s", which ran
-/// in 0.01 s.)
-pub const AUTO_SMALL_FLOPS: f64 = 2e9;
+/// refines all 400 (the costliest 5.7e9 flops); 2e9 left 39 of them in double (κ(W)
+/// 1.3e4–9.9e5), 15 of those off by more than 1e-11 (up to 1.3e-9), and their refinement
+/// takes 0.12 s on average, 0.21 s at most. (It was 2e8, "about 0.05 s", which ran in
+/// 0.01 s, then 2e9.)
+pub const AUTO_SMALL_FLOPS: f64 = 6e9;
 
 /// Where the operator `A⁻¹` and `W` come from.
 #[derive(Debug, Clone)]

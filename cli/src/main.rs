@@ -131,9 +131,10 @@ struct TraceArgs {
     threads: usize,
     /// Carry W and the condensed loads beyond double precision (mixed-precision
     /// refinement with the factor of A, for slender bodies whose W is ill-conditioned):
-    /// auto where the refinement is cheap (at most 2e8 flops: small problems, whatever W's
-    /// condition), or where the condition estimate of W exceeds 1e6 and the cost is
-    /// moderate.
+    /// auto where the refinement is cheap (at most 6e9 flops, about 0.3 s: small problems,
+    /// whatever W's condition), where the condition estimate of W exceeds 1e6 and the cost
+    /// is at most max(20 x the factorisation of A, 1e11 flops), or, whatever it costs, where
+    /// the estimate exceeds 1e8.
     #[arg(long, value_enum, default_value_t = Extended::Auto)]
     extended_precision: Extended,
     /// Write the JSON report to this file (every key: docs/json-report.md). The file is

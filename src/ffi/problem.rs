@@ -879,7 +879,7 @@ pub unsafe extern "C" fn fricont_problem_set_threads(
 /// load vectors by mixed-precision iterative refinement with its Cholesky factor of A
 /// (residuals in double-double, about four solves with the factor per column of Bᵀ at
 /// the build, and 2p × 2p more doubles of memory). Auto refines where the refinement is
-/// cheap (at most 2e9 floating-point operations, about 0.1 s: small problems, whose
+/// cheap (at most 6e9 floating-point operations, about 0.3 s: small problems, whose
 /// events then carry about 1e-14 instead of 1e-12 to 1e-9 relative error), and where an
 /// estimate of the 2-norm condition number of the equilibrated W exceeds 1e6 and the
 /// refinement's estimated cost is at most max(20 × the factorisation's, 1e11
