@@ -525,7 +525,7 @@ fn sine_walk(tr: &common::reference::RefTrace, start: &[Class], amp: f64) -> (Ve
 }
 
 /// A general load in double alone on a moderately slender body (67 × 6 nodes on
-/// 2.82 × 0.115, κ(W) ≈ 9.7e5, which `auto` leaves in double): `f0 + 1.5 sin(500 α) f1`,
+/// 2.82 × 0.115, κ(W) ≈ 9.7e5, `off`; `auto` refines it): `f0 + 1.5 sin(500 α) f1`,
 /// its 664 events to 1e-9 in φ (in double W's rounding alone moves the affine events by
 /// up to 1.0e-10). Solved afresh at each α, the guards carried rounding of cond · ε of
 /// the whole load, different at each α: the march stopped loudly after 325 events (the
