@@ -483,6 +483,8 @@ impl Path {
         // (1e-4 of λ on the p = 1920 strip), the double-precision point made a guard
         // crossed at the piece's entry and the exit went backwards.
         let refined = self.refine_piece(cur);
+        // Set again below where this piece's exit is taken on its refined line.
+        self.carried = None;
         let (lam0, t, rate) = match &refined {
             Some(r) => {
                 let [lam_e, d_e, lam_1, d_1] = &r.rounded;
@@ -647,6 +649,7 @@ impl Path {
                 let (lam, alpha, g) = match polished {
                     Some((l2, a2, g2)) if super::polish::near(&l2, &lam, self.force_scale(&pt)) => {
                         on_line = None;
+                        self.carried = refined.as_ref().map(|r| r.carried_at(cur.alpha, a2));
                         (l2, a2, g2)
                     }
                     _ => (lam, alpha, g),

@@ -262,6 +262,9 @@ pub struct Path {
     /// Guards that the current transition point found positive in double-double though
     /// within their thresholds (see `join::transit`): they let a candidate piece in.
     resolved: RefCell<Vec<crate::piece::Guard>>,
+    /// In extended precision, the last straight piece's exit on its refined line (see
+    /// `polish::CarriedPoint`).
+    carried: Option<polish::CarriedPoint>,
 }
 
 /// The traced data and the current position.
@@ -950,6 +953,7 @@ impl Path {
             scale_cache: PointCache::new(),
             graph_step: Cell::new(None),
             resolved: RefCell::new(Vec::new()),
+            carried: None,
         })
     }
 

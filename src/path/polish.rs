@@ -232,30 +232,49 @@ impl Refiner<'_> {
     /// where a fresh LU's did, and the exit kept in double, 2e-5 in α off, made the path
     /// turn back at a fold it does not have).
     fn refine_all(&self, pairs: Vec<(DdVec, DdVec)>) -> Option<Vec<(DdVec, DdVec)>> {
-        if !self.updated {
-            return self.refine_by(&self.solve, pairs);
-        }
-        self.refine_by(&self.solve, pairs.clone()).or_else(|| {
-            let lu = DenseLu::new(self.c.piece_matrix(self.w, self.classes).as_ref());
-            let fresh = |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect();
-            self.refine_by(&fresh, pairs)
-        })
+        self.refine_all_known(pairs, &[])
     }
 
-    /// [`Self::refine_all`] with the piece's solves `solve`.
+    /// [`Self::refine_all`], where `known[j]` (when given) is pair j's `d = W x + c`
+    /// already, in double-double (see [`CarriedPoint`]): its product with W is skipped.
+    fn refine_all_known(
+        &self,
+        pairs: Vec<(DdVec, DdVec)>,
+        known: &[Option<DdVec>],
+    ) -> Option<Vec<(DdVec, DdVec)>> {
+        if !self.updated {
+            return self.refine_by(&self.solve, pairs, known);
+        }
+        self.refine_by(&self.solve, pairs.clone(), known)
+            .or_else(|| {
+                let lu = DenseLu::new(self.c.piece_matrix(self.w, self.classes).as_ref());
+                let fresh = |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect();
+                self.refine_by(&fresh, pairs, known)
+            })
+    }
+
+    /// [`Self::refine_all_known`] with the piece's solves `solve`.
     fn refine_by(
         &self,
         solve: &SolveFn<'_>,
         pairs: Vec<(DdVec, DdVec)>,
+        known: &[Option<DdVec>],
     ) -> Option<Vec<(DdVec, DdVec)>> {
         let floors: Vec<f64> = pairs.iter().map(|(_, c)| self.floor(c)).collect();
-        let refs: Vec<(&DdVec, &DdVec)> = pairs.iter().map(|(x, c)| (x, c)).collect();
-        let ds = gaps_dd(self.w, self.w_lo, &refs);
-        let mut xs: Vec<(DdVec, DdVec)> = pairs
-            .into_iter()
-            .zip(ds)
-            .map(|((x, _), d)| (x, d))
+        let known_d = |j: usize| known.get(j).and_then(|d| d.as_ref());
+        let refs: Vec<(&DdVec, &DdVec)> = (0..pairs.len())
+            .filter(|&j| known_d(j).is_none())
+            .map(|j| (&pairs[j].0, &pairs[j].1))
             .collect();
+        let mut ds = gaps_dd(self.w, self.w_lo, &refs).into_iter();
+        let mut xs: Vec<(DdVec, DdVec)> = Vec::with_capacity(pairs.len());
+        for (j, (x, _)) in pairs.into_iter().enumerate() {
+            let d = match known_d(j) {
+                Some(d) => d.clone(),
+                None => ds.next()?,
+            };
+            xs.push((x, d));
+        }
         let (c, m) = (&self.c, self.w.nrows());
         let mut last = vec![f64::INFINITY; xs.len()];
         let mut done = vec![false; xs.len()];
@@ -344,9 +363,51 @@ pub(super) struct RefinedPiece {
     lam_1: DdVec,
     d_1: DdVec,
     pub(super) rounded: [Vec<f64>; 4],
+    /// Pieces since `d_e` came from a product with W in double-double (0: this one's; see
+    /// [`CarriedPoint`]).
+    hops: usize,
 }
 
+/// The exit point of a refined straight piece on its line in double-double, `λ_e + s λ'`
+/// with its `d_e + s d'` (`s = α − α_e` exact), at the exit's α rounded to double: d is
+/// `W λ + q(α) − (g, 0)` there to the rounding of those sums, so the next piece's point is
+/// refined from it without a product with W in double-double (of its two per piece, the
+/// costlier part of a trace in extended precision). Every [`CARRY_REFRESH`]-th piece
+/// computes that product afresh, so the carried sums' rounding (~1e-32 of their terms per
+/// piece) cannot build up.
+#[derive(Clone)]
+pub(super) struct CarriedPoint {
+    alpha: f64,
+    lam: DdVec,
+    d: DdVec,
+    hops: usize,
+}
+
+/// See [`CarriedPoint`].
+const CARRY_REFRESH: usize = 8;
+
 impl RefinedPiece {
+    /// The point on the refined line at `alpha` (the piece entered at `alpha_e`), to be
+    /// carried to the next piece (see [`CarriedPoint`]).
+    pub(super) fn carried_at(&self, alpha_e: f64, alpha: f64) -> CarriedPoint {
+        let (hi, lo) = crate::dd::two_sum(alpha, -alpha_e);
+        let s = Dd::new(hi, lo);
+        let m = self.lam_e.hi.len();
+        let along = |x: &DdVec, dx: &DdVec| {
+            let mut out = DdVec::from(&vec![0.0; m]);
+            for k in 0..m {
+                out.set(k, x.get(k) + dx.get(k) * s);
+            }
+            out
+        };
+        CarriedPoint {
+            alpha,
+            lam: along(&self.lam_e, &self.lam_1),
+            d: along(&self.d_e, &self.d_1),
+            hops: self.hops + 1,
+        }
+    }
+
     /// λ on the refined line at `alpha` (the piece entered at `alpha_e`), rounded to
     /// double: `λ_e + (α − α_e) λ'` in double-double, the difference of the two α exact.
     pub(super) fn lam_at(&self, alpha_e: f64, alpha: f64) -> Vec<f64> {
@@ -583,12 +644,51 @@ impl Path {
         };
         let ta = cur.t[m];
         let rate0: Vec<f64> = cur.t[..m].iter().map(|v| v / ta).collect();
-        let mut refined = r
-            .refine_all(vec![
-                (DdVec::from(&start), r.point_constant(cur.alpha)),
-                (DdVec::from(&rate0), r.rate_constant()),
-            ])?
-            .into_iter();
+        // The last piece's exit on its refined line where this piece starts there, with
+        // its d (see CarriedPoint); else the piece's own point in double.
+        let carried = self
+            .carried
+            .as_ref()
+            .filter(|cp| cp.alpha == cur.alpha && cp.hops < CARRY_REFRESH)
+            .filter(|cp| cp.lam.hi.len() == m)
+            .cloned();
+        let refine = |x0: DdVec, d0: Option<DdVec>| {
+            r.refine_all_known(
+                vec![
+                    (x0, r.point_constant(cur.alpha)),
+                    (DdVec::from(&rate0), r.rate_constant()),
+                ],
+                &[d0],
+            )
+        };
+        // From the piece's own point in double where nothing is carried, or where the
+        // refinement from the carried point fails.
+        let from_start = || refine(DdVec::from(&start), None).map(|v| (v, 0));
+        let refined = match carried {
+            Some(cp) => {
+                let (mut lam, mut d) = (cp.lam, cp.d);
+                // A node open on this piece has λ = 0 exactly, as its solves give it: on
+                // the last line a node that opens here is at its root, within rounding of
+                // zero (d then corrected by W times the change, O(m) per row).
+                let p = self.problem.p();
+                let open = (0..p).filter(|&i| cur.classes[i] == Class::Open);
+                for row in open.flat_map(|i| [i, p + i]) {
+                    let v = lam.get(row).to_f64();
+                    if v != 0.0 || lam.lo[row] != 0.0 {
+                        lam.set(row, Dd::ZERO);
+                        for (k, wk) in r.w.col(row).iter().enumerate() {
+                            d.set(k, d.get(k).add_f64(-wk * v));
+                        }
+                    }
+                }
+                refine(lam, Some(d))
+                    .map(|v| (v, cp.hops))
+                    .or_else(from_start)
+            }
+            None => from_start(),
+        };
+        let (refined, hops) = refined?;
+        let mut refined = refined.into_iter();
         let (lam_e, d_e) = refined.next()?;
         let (lam_1, d_1) = refined.next()?;
         let round = |v: &DdVec| -> Vec<f64> { (0..m).map(|k| v.get(k).to_f64()).collect() };
@@ -602,6 +702,7 @@ impl Path {
                 lam_1,
                 d_1,
                 rounded,
+                hops,
             })
     }
 
