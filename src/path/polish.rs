@@ -116,8 +116,9 @@ fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
     v
 }
 
-/// The piece's solves `b ↦ M_S⁻¹ b` for several columns at once (seed's row scaling).
-type SolveFn<'a> = dyn Fn(&[Vec<f64>]) -> Vec<Vec<f64>> + 'a;
+/// The piece's solves `b ↦ M_S⁻¹ b` for several columns at once (seed's row scaling),
+/// with W times each solution where the solve computed it to check itself.
+type SolveFn<'a> = dyn Fn(&[Vec<f64>]) -> (Vec<Vec<f64>>, Option<Vec<Vec<f64>>>) + 'a;
 type PieceSolve<'a> = Box<SolveFn<'a>>;
 
 /// What a refinement on one piece needs: the constants, W (both parts), the load's
@@ -248,7 +249,7 @@ impl Refiner<'_> {
         self.refine_by(&self.solve, pairs.clone(), known)
             .or_else(|| {
                 let lu = DenseLu::new(self.c.piece_matrix(self.w, self.classes).as_ref());
-                let fresh = |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect();
+                let fresh = |bs: &[Vec<f64>]| (bs.iter().map(|b| lu.solve(b)).collect(), None);
                 self.refine_by(&fresh, pairs, known)
             })
     }
@@ -296,8 +297,12 @@ impl Refiner<'_> {
                     r
                 })
                 .collect();
-            let dxs = solve(&rs);
-            let wdx = mat_mul(self.w, &dxs.iter().map(|v| &v[..]).collect::<Vec<_>>());
+            // (W δ from the checked solve's own residual where it has it)
+            let (dxs, wdxs) = solve(&rs);
+            let wdx = match wdxs {
+                Some(w) if w.len() == dxs.len() => w,
+                _ => mat_mul(self.w, &dxs.iter().map(|v| &v[..]).collect::<Vec<_>>()),
+            };
             for ((&j, dx), wdx) in active.iter().zip(&dxs).zip(wdx) {
                 let (x, d) = &mut xs[j];
                 let size = inf_norm(&x.hi);
@@ -480,14 +485,16 @@ impl Path {
             Some(u) => Box::new(move |bs: &[Vec<f64>]| {
                 let cols: Vec<update::Rhs<'_>> =
                     bs.iter().map(|b| update::Rhs { b, guess: None }).collect();
-                u.solve_checked_many(&c, w, &cols, row_bound)
+                let (xs, wxs) = u
+                    .solve_checked_many(&c, w, &cols, row_bound)
                     .into_iter()
-                    .map(|k| k.x)
-                    .collect()
+                    .map(|k| (k.x, k.wx))
+                    .unzip();
+                (xs, Some(wxs))
             }),
             None => {
                 let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
-                Box::new(move |bs: &[Vec<f64>]| bs.iter().map(|b| lu.solve(b)).collect())
+                Box::new(move |bs: &[Vec<f64>]| (bs.iter().map(|b| lu.solve(b)).collect(), None))
             }
         };
         Some(Refiner {
