@@ -395,20 +395,11 @@ impl RefinedPiece {
     /// The point on the refined line at `alpha` (the piece entered at `alpha_e`), to be
     /// carried to the next piece (see [`CarriedPoint`]).
     pub(super) fn carried_at(&self, alpha_e: f64, alpha: f64) -> CarriedPoint {
-        let (hi, lo) = crate::dd::two_sum(alpha, -alpha_e);
-        let s = Dd::new(hi, lo);
-        let m = self.lam_e.hi.len();
-        let along = |x: &DdVec, dx: &DdVec| {
-            let mut out = DdVec::from(&vec![0.0; m]);
-            for k in 0..m {
-                out.set(k, x.get(k) + dx.get(k) * s);
-            }
-            out
-        };
+        let s = along_from(alpha_e, alpha);
         CarriedPoint {
             alpha,
-            lam: along(&self.lam_e, &self.lam_1),
-            d: along(&self.d_e, &self.d_1),
+            lam: on_line(&self.lam_e, &self.lam_1, s),
+            d: on_line(&self.d_e, &self.d_1, s),
             hops: self.hops + 1,
         }
     }
@@ -416,17 +407,30 @@ impl RefinedPiece {
     /// λ on the refined line at `alpha` (the piece entered at `alpha_e`), rounded to
     /// double: `λ_e + (α − α_e) λ'` in double-double, the difference of the two α exact.
     pub(super) fn lam_at(&self, alpha_e: f64, alpha: f64) -> Vec<f64> {
-        let (hi, lo) = crate::dd::two_sum(alpha, -alpha_e);
-        self.lam_along(Dd::new(hi, lo))
+        self.lam_along(along_from(alpha_e, alpha))
     }
 
     /// λ on the refined line `s` along α from its entry, `λ_e + s λ'` in double-double,
     /// rounded to double.
     fn lam_along(&self, s: Dd) -> Vec<f64> {
-        (0..self.lam_e.hi.len())
-            .map(|k| (self.lam_e.get(k) + self.lam_1.get(k) * s).to_f64())
-            .collect()
+        let lam = on_line(&self.lam_e, &self.lam_1, s);
+        (0..lam.hi.len()).map(|k| lam.get(k).to_f64()).collect()
     }
+}
+
+/// `α − α_e`, exact in double-double.
+fn along_from(alpha_e: f64, alpha: f64) -> Dd {
+    let (hi, lo) = crate::dd::two_sum(alpha, -alpha_e);
+    Dd::new(hi, lo)
+}
+
+/// `x + s dx` in double-double.
+fn on_line(x: &DdVec, dx: &DdVec, s: Dd) -> DdVec {
+    let mut out = DdVec::from(&vec![0.0; x.hi.len()]);
+    for k in 0..x.hi.len() {
+        out.set(k, x.get(k) + dx.get(k) * s);
+    }
+    out
 }
 
 /// A double-double point `lam2` is taken for the double-precision one `lam` without
@@ -657,7 +661,6 @@ impl Path {
             .carried
             .as_ref()
             .filter(|cp| cp.alpha == cur.alpha && cp.hops < CARRY_REFRESH)
-            .filter(|cp| cp.lam.hi.len() == m)
             .cloned();
         let refine = |x0: DdVec, d0: Option<DdVec>| {
             r.refine_all_known(
