@@ -997,12 +997,11 @@ fricont_status fricont_problem_set_threads(struct fricont_problem *problem,
  * refinement's estimated cost is at most max(20 × the factorisation's, 1e11
  * floating-point operations), or whatever it costs where that estimate exceeds 1e8
  * (there double's rounding moved a transition of a slender strip by 4.3e-3 in α); off
- * never. A problem
- * made from condensed data (`fricont_problem_new_condensed`) is never refined (its W is
- * the caller's data); with on (or auto and an ill-conditioned W) it is traced in
- * extended precision all the same. Like the friction, a change drops the factorisation:
- * the next build (explicit or by `fricont_path_new_*`) factorises A again; existing
- * paths are not affected. Query the outcome with
+ * never. A problem made from condensed data (`fricont_problem_new_condensed`) is never
+ * refined (its W is the caller's data); with on (or auto and an ill-conditioned W) it is
+ * traced in extended precision all the same. Like the friction, a change drops the
+ * factorisation: the next build (explicit or by `fricont_path_new_*`) factorises A
+ * again; existing paths are not affected. Query the outcome with
  * `fricont_problem_extended_precision`. Under a general load
  * (`fricont_path_new_general`) each evaluation is refined too, at about twice its cost:
  * in double alone the solutions at neighbouring α of a slender body disagree by more

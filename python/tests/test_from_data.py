@@ -322,12 +322,13 @@ def glued_mirror(case, nx, ny):
 
 def test_a_symmetric_beam_under_an_oscillating_basis_load_stays_symmetric(tmp_path):
     """A 101 × 21 strip on 10 × 0.6 glued to its mirror image (p = 199, κ(W) = 1.6e5,
-    traced in double: "off"), F = 3, under the basis load f0 + φ(α) f1, φ(α) = α + 0.03 sin 10α, on [0, 3]:
-    the path is symmetric, every event has its mirror image (the image node, slip+ and
-    slip− swapped) at the same α to 1e-9. Where a piece's points were taken from its entry
-    in double (meant for unrefined basis solutions in extended precision), the points
-    carried the transition point's rounding and the trace stopped after 348 of its 354
-    events: "node 103 fits no class". The ends of its pieces hold from the data."""
+    traced in double: "off"), F = 3, under the basis load f0 + φ(α) f1,
+    φ(α) = α + 0.03 sin 10α, on [0, 3]: the path is symmetric, every event has its mirror
+    image (the image node, slip+ and slip− swapped) at the same α to 1e-9. Where a piece's
+    points were taken from its entry in double (meant for unrefined basis solutions in
+    extended precision), the points carried the transition point's rounding and the trace
+    stopped after 348 of its 354 events: "node 103 fits no class". The ends of its pieces
+    hold from the data."""
     case = generated("strip-101x21", tmp_path)
     A2, N2, T2, f0, f1, image = glued_mirror(case, 101, 21)
     p2 = N2.shape[0]
