@@ -158,37 +158,115 @@ impl faer::traits::pulp::WithSimd for GemvDd<'_> {
     type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: faer::traits::pulp::Simd>(self, _: S) {
+    fn with_simd<S: faer::traits::pulp::Simd>(self, simd: S) {
         let m = self.w.nrows();
-        for k in 0..m {
-            let col = self.w.col(k).try_as_col_major().expect("contiguous column");
-            let a = col.as_slice();
-            for (v, &(xh, xl)) in self.xs.iter().enumerate() {
-                let (mut s, mut c) = ([0.0f64; 4], [0.0f64; 4]);
-                let chunks = m / 4;
-                for j in 0..chunks {
-                    for l in 0..4 {
-                        let i = 4 * j + l;
-                        let p = a[i] * xh[i];
-                        let e = a[i].mul_add(xh[i], -p);
-                        let s2 = s[l] + p;
-                        let bb = s2 - s[l];
-                        let f = (s[l] - (s2 - bb)) + (p - bb);
-                        s[l] = s2;
-                        c[l] += e + f + a[i] * xl[i];
-                    }
-                }
-                let mut tot = Dd::ZERO;
-                for l in 0..4 {
-                    tot = tot + Dd::new(s[l], c[l]);
-                }
-                for i in 4 * chunks..m {
-                    tot = tot + Dd::prod(a[i], xh[i]).add_f64(a[i] * xl[i]);
-                }
-                self.out[v][k] = tot;
+        let col = |k: usize| {
+            self.w
+                .col(k)
+                .try_as_col_major()
+                .expect("contiguous column")
+                .as_slice()
+        };
+        // Lane l of a vector holds the entries 4j + l: the scalar lanes of `dot_lanes`,
+        // so both give the same bits. Four rows at a time share the loads of x.
+        let four = S::F64_LANES == 4;
+        let mut k = 0;
+        while four && k + 4 <= m {
+            let rows = [0, 1, 2, 3].map(|r| col(k + r));
+            for (out, &(xh, xl)) in self.out.iter_mut().zip(self.xs) {
+                out[k..k + 4].copy_from_slice(&dot4_dd(simd, rows, xh, xl));
+            }
+            k += 4;
+        }
+        for k in k..m {
+            for (out, &(xh, xl)) in self.out.iter_mut().zip(self.xs) {
+                out[k] = dot_lanes(col(k), xh, xl);
             }
         }
     }
+}
+
+/// The compensated sum of `a_i (xh_i + xl_i)` in four lanes (lane l: the entries 4j + l,
+/// the rest after the lanes are combined): the products' errors from the fused
+/// multiply-add, the sums' from two-sum.
+#[inline(always)]
+fn dot_lanes(a: &[f64], xh: &[f64], xl: &[f64]) -> Dd {
+    let m = a.len();
+    let (mut s, mut c) = ([0.0f64; 4], [0.0f64; 4]);
+    let chunks = m / 4;
+    for j in 0..chunks {
+        for l in 0..4 {
+            let i = 4 * j + l;
+            let p = a[i] * xh[i];
+            let e = a[i].mul_add(xh[i], -p);
+            let s2 = s[l] + p;
+            let bb = s2 - s[l];
+            let f = (s[l] - (s2 - bb)) + (p - bb);
+            s[l] = s2;
+            c[l] += e + f + a[i] * xl[i];
+        }
+    }
+    finish_lanes(s, c, &a[4 * chunks..], &xh[4 * chunks..], &xl[4 * chunks..])
+}
+
+/// The four lanes `(s, c)` combined, then the entries after them added.
+#[inline(always)]
+fn finish_lanes(s: [f64; 4], c: [f64; 4], a: &[f64], xh: &[f64], xl: &[f64]) -> Dd {
+    let mut tot = Dd::ZERO;
+    for l in 0..4 {
+        tot = tot + Dd::new(s[l], c[l]);
+    }
+    for i in 0..a.len() {
+        tot = tot + Dd::prod(a[i], xh[i]).add_f64(a[i] * xl[i]);
+    }
+    tot
+}
+
+/// [`dot_lanes`] of four columns `a` with the same x, in vectors of four lanes
+/// (`S::F64_LANES == 4`): the same operations on the same entries.
+#[inline(always)]
+fn dot4_dd<S: faer::traits::pulp::Simd>(
+    simd: S,
+    a: [&[f64]; 4],
+    xh: &[f64],
+    xl: &[f64],
+) -> [Dd; 4] {
+    let av = a.map(|a| S::as_simd_f64s(a).0);
+    let (hv, _) = S::as_simd_f64s(xh);
+    let (lv, _) = S::as_simd_f64s(xl);
+    let zero = simd.splat_f64s(0.0);
+    let (mut s, mut c) = ([zero; 4], [zero; 4]);
+    for (j, (&h, &lo)) in hv.iter().zip(lv).enumerate() {
+        for r in 0..4 {
+            let w = av[r][j];
+            let p = simd.mul_f64s(w, h);
+            let e = simd.mul_add_f64s(w, h, simd.neg_f64s(p));
+            let s2 = simd.add_f64s(s[r], p);
+            let bb = simd.sub_f64s(s2, s[r]);
+            let f = simd.add_f64s(
+                simd.sub_f64s(s[r], simd.sub_f64s(s2, bb)),
+                simd.sub_f64s(p, bb),
+            );
+            s[r] = s2;
+            let t = simd.add_f64s(simd.add_f64s(e, f), simd.mul_f64s(w, lo));
+            c[r] = simd.add_f64s(c[r], t);
+        }
+    }
+    let lanes = |v: S::f64s| {
+        let mut out = [0.0f64; 4];
+        S::as_mut_simd_f64s(&mut out[..]).0[0] = v;
+        out
+    };
+    let done = 4 * hv.len();
+    [0, 1, 2, 3].map(|r| {
+        finish_lanes(
+            lanes(s[r]),
+            lanes(c[r]),
+            &a[r][done..],
+            &xh[done..],
+            &xl[done..],
+        )
+    })
 }
 
 #[cfg(test)]
@@ -224,20 +302,32 @@ mod tests {
 
     #[test]
     fn symmetric_products_agree_with_the_scalar_dot() {
-        // A symmetric W of mixed sizes (m = 11: two lanes' chunks and a remainder).
-        let m = 11;
-        let w = faer::Mat::<f64>::from_fn(m, m, |i, j| {
-            let (a, b) = (i.min(j) as f64, i.max(j) as f64);
-            (1.0 + a * 0.37 + b * 1.3).sin() * 10f64.powi(((a + b) as i32 % 7) - 3)
-        });
-        let xh: Vec<f64> = (0..m).map(|i| (i as f64 * 0.9).cos() * 1e3).collect();
-        let xl: Vec<f64> = xh.iter().map(|v| v * 1e-17).collect();
-        let got = sym_gemv_dd(w.as_ref(), &[(&xh, &xl)]);
-        for k in 0..m {
-            let col: Vec<f64> = (0..m).map(|i| w[(i, k)]).collect();
-            let want = dot_dd(&col, &xh, &xl);
-            let d = (got[0][k] - want).to_f64().abs();
-            assert!(d <= 1e-30 * want.to_f64().abs().max(1.0), "row {k}: {d:e}");
+        // Symmetric W of mixed sizes: rows in blocks of four and after them, columns in
+        // chunks of four lanes and a remainder; two x at once. Each entry within 1e-30
+        // of the one-lane compensated dot, and bitwise the scalar four-lane sum (the
+        // vector kernel must do the same operations on the same entries).
+        for m in [3usize, 4, 11, 17] {
+            let w = faer::Mat::<f64>::from_fn(m, m, |i, j| {
+                let (a, b) = (i.min(j) as f64, i.max(j) as f64);
+                (1.0 + a * 0.37 + b * 1.3).sin() * 10f64.powi(((a + b) as i32 % 7) - 3)
+            });
+            let xh: Vec<f64> = (0..m).map(|i| (i as f64 * 0.9).cos() * 1e3).collect();
+            let xl: Vec<f64> = xh.iter().map(|v| v * 1e-17).collect();
+            let yh: Vec<f64> = (0..m).map(|i| (i as f64 * 2.1).sin() * 1e-2).collect();
+            let yl: Vec<f64> = yh.iter().map(|v| -v * 3e-18).collect();
+            let got = sym_gemv_dd(w.as_ref(), &[(&xh, &xl), (&yh, &yl)]);
+            for (v, (h, l)) in [(&xh, &xl), (&yh, &yl)].into_iter().enumerate() {
+                for k in 0..m {
+                    let col: Vec<f64> = (0..m).map(|i| w[(i, k)]).collect();
+                    let want = dot_dd(&col, h, l);
+                    let d = (got[v][k] - want).to_f64().abs();
+                    assert!(
+                        d <= 1e-30 * want.to_f64().abs().max(1.0),
+                        "m {m} row {k}: {d:e}"
+                    );
+                    assert_eq!(got[v][k], dot_lanes(&col, h, l), "m {m}, x {v}, row {k}");
+                }
+            }
         }
     }
 }
