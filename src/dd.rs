@@ -136,8 +136,10 @@ pub(crate) fn dot_dd(a: &[f64], x_hi: &[f64], x_lo: &[f64]) -> Dd {
 
 /// `W x` in double-double for the symmetric `W` (m × m, column-major, each column
 /// contiguous) and each double-double vector `x = x_hi + x_lo` of `xs`: row k is read as
-/// column k, and every dot product runs in four independent lanes (compensated), compiled
-/// for the machine's vector instructions with fused multiply-adds by faer's dispatch.
+/// column k, and every dot product runs in four independent lanes (compensated), as
+/// vectors of four lanes where faer's dispatch gives them (AVX2 with fused multiply-adds;
+/// 0.28 ms at m = 960 against 1.03 ms in scalar code), four rows at a time; else in
+/// scalar code, with the same bits.
 pub(crate) fn sym_gemv_dd(w: faer::MatRef<'_, f64>, xs: &[(&[f64], &[f64])]) -> Vec<Vec<Dd>> {
     let mut out = vec![vec![Dd::ZERO; w.nrows()]; xs.len()];
     faer::traits::pulp::Arch::new().dispatch(GemvDd {
