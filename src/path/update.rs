@@ -55,7 +55,7 @@ pub(crate) fn max_updates(m: usize) -> usize {
 /// A factorised base piece matrix, shared by every update derived from it.
 pub(super) struct Base {
     lu: DenseLu,
-    /// `M_0⁻¹ [e_i, e_{p+i}]` for node i and W times it, computed on first use.
+    /// `M_0⁻¹ [e_i, e_{p+i}]` for node i, computed on first use.
     z: Mutex<HashMap<usize, Arc<NodeCols>>>,
 }
 
