@@ -219,3 +219,112 @@ fn directional_problem_at_a_vertex_of_many_nodes() {
         "only {through} paths went through a vertex of ≥ 7 nodes"
     );
 }
+
+/// A condensed problem whose `p` nodes (13 to 40: 2^p > 4096 neighbouring pieces) all
+/// reach their friction cone's edge at α = 0 together: on the all-stick piece `d = 0`, so
+/// `λ(α) = −W⁻¹ q(α)` whatever W, and `q(α) = −W (λ* + α y)` puts λ on the all-stick
+/// piece with every node's λt at `−σ_i F λν_i` at α = 0 (σ_i = ±1, λν_i < 0) and inside
+/// its cone before. W is random SPD and couples the nodes, so which of them slip after
+/// α = 0 is the directional problem of that point (the path pivots on their classes, see
+/// `Path::pivoted_classes`). Checked against the fixed-α solver started afresh at half
+/// the way to the next event: the same classes and the same λ (1e-10 of the forces).
+#[test]
+fn many_nodes_reach_their_friction_limit_together() {
+    use fricont::problem::ProblemBuilder;
+    let mut mixed = 0;
+    for seed in 0..10u64 {
+        let mut rng = common::Rng::new(4000 + seed);
+        let p = 13 + rng.int(0, 27);
+        let m = 2 * p;
+        let friction = rng.range(0.05, 0.6);
+        // W = D + G Gᵀ / m: SPD, every node coupled to every other (entries about
+        // 1/√m of the diagonal), near enough to diagonal for one solution at each α.
+        let g = nalgebra::DMatrix::<f64>::from_fn(m, m, |_, _| rng.range(-1.0, 1.0));
+        let d = nalgebra::DVector::<f64>::from_fn(m, |_, _| rng.range(1.0, 2.0));
+        let w = nalgebra::DMatrix::from_diagonal(&d) + &g * g.transpose() * (2.0 / m as f64);
+        let w = (&w + w.transpose()) * 0.5;
+        let (mut lam0, mut y) = (vec![0.0; m], vec![0.0; m]);
+        for i in 0..p {
+            let (a, sigma) = (
+                rng.range(1.0, 2.0),
+                if rng.uniform() < 0.5 { 1.0 } else { -1.0 },
+            );
+            let yn = rng.range(-0.1, 0.1);
+            lam0[i] = -a;
+            lam0[p + i] = sigma * friction * a;
+            y[i] = yn;
+            // Inside the cone before α = 0: σ (λt + σ F λν) < 0 there, zero at 0.
+            y[p + i] = sigma * (friction * yn.abs() + 10f64.powf(rng.range(-3.0, 0.0)));
+        }
+        let wl = |v: &[f64]| -> Vec<f64> {
+            let x = &w * nalgebra::DVector::from_column_slice(v);
+            x.iter().map(|v| -v).collect()
+        };
+        let load = || Load::affine(wl(&lam0), wl(&y)).unwrap();
+        let wf = faer::Mat::<f64>::from_fn(m, m, |i, j| w[(i, j)]);
+        let problem = Arc::new(
+            ProblemBuilder::condensed(wf)
+                .friction_uniform(friction)
+                .build()
+                .expect("problem"),
+        );
+        let ctx = format!("seed {seed} (p = {p}, F = {friction:.3})");
+        compare(&ctx, problem.clone(), load, -friction, 1.0);
+        // From α = −F: there every λt is still inside its cone on both sides.
+        let mut path = run(&problem, load(), -friction, 1.0, false);
+        assert_eq!(
+            path.end_reason(),
+            Some(&fricont::EndReason::Window),
+            "{ctx}: end"
+        );
+        let at_zero = path
+            .events()
+            .iter()
+            .filter(|e| e.alpha.abs() < 1e-12)
+            .count();
+        assert!(at_zero > 0, "{ctx}: no event at α = 0");
+        assert!(
+            path.events().iter().all(|e| e.alpha > -1e-12),
+            "{ctx}: an event before α = 0"
+        );
+        let next = path
+            .events()
+            .iter()
+            .map(|e| e.alpha)
+            .find(|&a| a > 1e-12)
+            .unwrap_or(1.0);
+        let at = 0.5 * next;
+        let sols = path.solutions_at(at).expect("solutions_at");
+        assert_eq!(sols.len(), 1, "{ctx}: one solution at {at}");
+        let mut fresh = Path::new(problem.clone(), load(), PathOptions::window(at, 1.0)).unwrap();
+        fresh.start(at, None).expect("fresh start");
+        let want = fresh.start_state().expect("start state");
+        assert_eq!(
+            sols[0].state.classes, want.classes,
+            "{ctx}: classes at {at}"
+        );
+        let scale = want.lambda_n.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        for (a, b) in sols[0]
+            .state
+            .lambda_n
+            .iter()
+            .chain(&sols[0].state.lambda_t)
+            .zip(want.lambda_n.iter().chain(&want.lambda_t))
+        {
+            assert!((a - b).abs() <= 1e-10 * scale, "{ctx}: λ {a} vs {b}");
+        }
+        // Whether the directional problem's answer is not the trivial one: some nodes
+        // keep sticking.
+        let slipping = want
+            .classes
+            .iter()
+            .filter(|c| **c != fricont::Class::Stick)
+            .count();
+        eprintln!("{ctx}: {at_zero} events at 0, {slipping} of {p} slip after");
+        mixed += usize::from(slipping > 0 && slipping < p);
+    }
+    assert!(
+        mixed >= 5,
+        "only {mixed} of 10 with nodes sticking and slipping after"
+    );
+}

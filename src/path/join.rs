@@ -151,6 +151,41 @@ impl Path {
             .collect()
     }
 
+    /// Whether guard `row` (its slope taken along a piece's tangent t) lets the way `s`
+    /// along t (±1) into the piece's region at the point: None when it does; Some(true)
+    /// when it is at zero (see [`Tol::at_zero`]; `tols.1` for the nodes of `switching`,
+    /// whose guards are zero by construction, see [`Self::push_candidates`]) and does not
+    /// increase (`relaxed`: decreases beyond its slope threshold); Some(false) when it is
+    /// below zero (the piece does not contain the point).
+    fn guard_blocks(
+        &self,
+        row: &GuardRow,
+        s: f64,
+        (tol, tol_switching): (&Tol, &Tol),
+        switching: &[usize],
+        relaxed: bool,
+    ) -> Option<bool> {
+        let (v, vd) = (row.value, s * row.slope);
+        // A guard not at zero must be inside; one at zero must increase: its slope (force
+        // per unit of scaled arclength) against the scale of the point.
+        let form = self.consts().guard_form(row.guard);
+        // (positive, its root a distinct step away in double-double: see `transit`)
+        if v > 0.0 && self.resolved.borrow().contains(&row.guard) {
+            return None;
+        }
+        let tol_row = if switching.contains(&row.guard.node) {
+            tol_switching
+        } else {
+            tol
+        };
+        if !tol_row.at_zero(&form, v, vd) {
+            return if v > 0.0 { None } else { Some(false) };
+        }
+        let ts = tol.slope();
+        let ok = if relaxed { vd >= -ts } else { vd > ts };
+        (!ok).then_some(true)
+    }
+
     /// Adds the directions of piece `classes` through `pt` that enter its region.
     /// `switching`: the nodes that change class at the point. Their guards on the new
     /// piece are the old class's equations or guards, so one near zero is zero by
@@ -200,30 +235,8 @@ impl Path {
             }) {
                 continue;
             }
-            let c = self.consts();
-            let resolved = self.resolved.borrow();
-            // None: the guard lets the direction in; Some(at zero): it does not.
             let blocks = |row: &GuardRow| -> Option<bool> {
-                let (v, vd) = (row.value, s * row.slope);
-                // A guard not at zero must be inside; one at zero (see Tol::at_zero) must
-                // increase: its slope (force per unit of scaled arclength) against the
-                // scale of the point.
-                let form = c.guard_form(row.guard);
-                // (positive, its root a distinct step away in double-double: see `transit`)
-                if v > 0.0 && resolved.contains(&row.guard) {
-                    return None;
-                }
-                let tol_row = if switching.contains(&row.guard.node) {
-                    &tol_switching
-                } else {
-                    tol
-                };
-                if !tol_row.at_zero(&form, v, vd) {
-                    return if v > 0.0 { None } else { Some(false) };
-                }
-                let ts = tol.slope();
-                let ok = if relaxed { vd >= -ts } else { vd > ts };
-                (!ok).then_some(true)
+                self.guard_blocks(row, s, (tol, &tol_switching), switching, relaxed)
             };
             let enters = table.iter().all(|row| blocks(row).is_none());
             if !enters {
@@ -257,6 +270,8 @@ impl Path {
     /// when there are more than two of them: the continuation from such a point is
     /// positively homogeneous, so their classes are read off the solution of the
     /// directional contact problem `ḋ = W λ̇ ± q'` (the other nodes keep their class).
+    /// Where the other nodes are still too many and each fits two classes, theirs come
+    /// from [`Self::pivoted_classes`].
     #[allow(clippy::too_many_arguments)]
     fn continuations(
         &self,
@@ -300,6 +315,25 @@ impl Path {
             .iter()
             .fold(1usize, |acc, &k| acc.saturating_mul(options[k].len()));
         if combos > MAX_CANDIDATE_PIECES {
+            // Many nodes at a boundary between two classes at once (identical nodes
+            // reaching their friction limit together): a continuation per way along α by
+            // pivoting on their classes.
+            if options.iter().all(|o| o.len() <= 2) {
+                let mut out = Vec::new();
+                for want in [1.0, -1.0] {
+                    let Some(cl) =
+                        self.pivoted_classes(pt, fixed, nodes, &options, (want, relaxed), &tol)
+                    else {
+                        continue;
+                    };
+                    self.push_candidates(
+                        &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
+                    );
+                }
+                if !out.is_empty() {
+                    return Ok(out);
+                }
+            }
             return Err(Error::Numerical(format!(
                 "{} nodes are at a class boundary at once at alpha = {:e}: {combos} neighbouring pieces exceed the limit of {MAX_CANDIDATE_PIECES}",
                 enumerated.len(),
@@ -349,6 +383,82 @@ impl Path {
                 k += 1;
             }
         }
+    }
+
+    /// The classes of the piece that continues the path from `pt` with α moving along
+    /// `want` (±1), where more nodes are at a boundary between two classes than
+    /// [`MAX_CANDIDATE_PIECES`] lets [`Self::continuations`] enumerate: `nodes` fit the
+    /// classes `options` (one or two each), every other node keeps its class in `fixed`.
+    /// Which of the two classes a node takes is a linear complementarity problem in the
+    /// rates (the directional problem of the point, as at a zero-force vertex): a node
+    /// whose guard at zero decreases along the piece's tangent must take its other class.
+    /// Solved by principal pivoting, each step one piece's tangent (O(m²) by updates):
+    /// every node so blocked switches at once while that lowers their number, else the
+    /// first blocked node alone (Murty's rule, finite where the rates' matrix is a
+    /// P-matrix). None when a node outside `nodes` blocks, a class vector comes back, the
+    /// tangent does not move α, or after `4·|nodes| + 64` steps. What it returns is only a
+    /// candidate: [`Self::push_candidates`] checks that its piece enters its region. One
+    /// continuation per way: several (a bifurcation among these nodes) are not searched.
+    fn pivoted_classes(
+        &self,
+        pt: &Point,
+        fixed: &[Class],
+        nodes: &[usize],
+        options: &[Vec<Class>],
+        (want, relaxed): (f64, bool),
+        tol: &Tol,
+    ) -> Option<Vec<Class>> {
+        let scale = self.force_scale(pt);
+        let tol_switching = tol.clone().approximate();
+        let mut classes = fixed.to_vec();
+        for (k, &i) in nodes.iter().enumerate() {
+            if !options[k].contains(&classes[i]) {
+                classes[i] = options[k][0];
+            }
+        }
+        let slot = |i: usize| nodes.iter().position(|&n| n == i);
+        let mut seen = std::collections::HashSet::new();
+        let (mut fewest, mut single) = (usize::MAX, false);
+        for _ in 0..4 * nodes.len() + 64 {
+            if !seen.insert(classes.clone()) {
+                return None;
+            }
+            let tangent = self.tangent(&classes, pt, scale)?;
+            let t_alpha = tangent.t.last().copied().unwrap_or(0.0);
+            if t_alpha == 0.0 || !t_alpha.is_finite() {
+                return None;
+            }
+            let s = want * t_alpha.signum();
+            let table = self.guard_table(&classes, pt, Some((&tangent.t, &tangent.rate)));
+            let mut blocked = Vec::new();
+            for row in &table {
+                match self.guard_blocks(row, s, (tol, &tol_switching), nodes, relaxed) {
+                    None => {}
+                    Some(true) => match slot(row.guard.node) {
+                        Some(k) if options[k].len() == 2 => blocked.push(k),
+                        _ => return None,
+                    },
+                    Some(false) => return None,
+                }
+            }
+            blocked.sort_unstable();
+            blocked.dedup();
+            if blocked.is_empty() {
+                return Some(classes);
+            }
+            single |= blocked.len() >= fewest;
+            fewest = fewest.min(blocked.len());
+            let flip = if single { &blocked[..1] } else { &blocked[..] };
+            for &k in flip {
+                let i = nodes[k];
+                classes[i] = if classes[i] == options[k][0] {
+                    options[k][1]
+                } else {
+                    options[k][0]
+                };
+            }
+        }
+        None
     }
 
     /// [`Self::continuations`] with the slopes of guards at zero strictly positive, else,
