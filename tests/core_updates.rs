@@ -328,3 +328,46 @@ fn many_nodes_reach_their_friction_limit_together() {
         "only {mixed} of 10 with nodes sticking and slipping after"
     );
 }
+
+/// Twenty identical decoupled nodes (W = I/2, condensed), each pressed by `q_ν = 1/2`
+/// and sheared by `q_t = α/2`, with F = 1/2. By hand: on the all-stick piece `d = 0`
+/// gives `λν = −1`, `λt = −α`, inside the cone (|λt| < −F λν) for α < 1/2; at α = 1/2
+/// every node reaches `λt = F λν` together (2^20 neighbouring pieces), and after it each
+/// slips in +t: `λν = −1`, `λt = F λν = −1/2`, `dt = α/2 − 1/4 > 0`.
+#[test]
+fn identical_decoupled_nodes_slip_together() {
+    use fricont::problem::ProblemBuilder;
+    let p = 20;
+    let w = faer::Mat::<f64>::from_fn(2 * p, 2 * p, |i, j| if i == j { 0.5 } else { 0.0 });
+    let problem = Arc::new(
+        ProblemBuilder::condensed(w)
+            .friction_uniform(0.5)
+            .build()
+            .expect("problem"),
+    );
+    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
+    q0[..p].fill(0.5);
+    q1[p..].fill(0.5);
+    let mut path = run(&problem, Load::affine(q0, q1).unwrap(), 0.0, 2.0, false);
+    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
+    let ev = path.events();
+    assert_eq!(ev.len(), p, "one event per node");
+    for e in ev {
+        assert!((e.alpha - 0.5).abs() <= 1e-15, "event at α = {}", e.alpha);
+        assert_eq!(
+            (e.from, e.to, e.fold, e.bifurcation),
+            (
+                fricont::Class::Stick,
+                fricont::Class::SlipPlus,
+                false,
+                false
+            )
+        );
+    }
+    let sols = path.solutions_at(1.0).expect("solutions_at");
+    assert_eq!(sols.len(), 1);
+    for i in 0..p {
+        assert!((sols[0].state.lambda_n[i] + 1.0).abs() <= 1e-15);
+        assert!((sols[0].state.lambda_t[i] + 0.5).abs() <= 1e-15);
+    }
+}
