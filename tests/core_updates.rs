@@ -333,7 +333,8 @@ fn many_nodes_reach_their_friction_limit_together() {
 /// and sheared by `q_t = α/2`, with F = 1/2. By hand: on the all-stick piece `d = 0`
 /// gives `λν = −1`, `λt = −α`, inside the cone (|λt| < −F λν) for α < 1/2; at α = 1/2
 /// every node reaches `λt = F λν` together (2^20 neighbouring pieces), and after it each
-/// slips in +t: `λν = −1`, `λt = F λν = −1/2`, `dt = α/2 − 1/4 > 0`.
+/// slips in +t: `λν = −1`, `λt = F λν = −1/2`, `dt = α/2 − 1/4 > 0`. Under an affine, a
+/// basis and a general load.
 #[test]
 fn identical_decoupled_nodes_slip_together() {
     use fricont::problem::ProblemBuilder;
@@ -369,5 +370,65 @@ fn identical_decoupled_nodes_slip_together() {
     for i in 0..p {
         assert!((sols[0].state.lambda_n[i] + 1.0).abs() <= 1e-15);
         assert!((sols[0].state.lambda_t[i] + 0.5).abs() <= 1e-15);
+    }
+    // The same under the basis load `q0 + φ(α) q1`, φ(α) = α³ + α/4, and as a general
+    // load: the nodes slip together where φ = 1/2, at the root of 4α³ + α − 2 (by
+    // Newton here).
+    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
+    q0[..p].fill(0.5);
+    q1[p..].fill(0.5);
+    let basis = Load::basis(
+        vec![q0, q1],
+        Box::new(
+            |a: f64, w: &mut [f64], dw: &mut [f64]| -> Result<(), LoadFailure> {
+                w[0] = 1.0;
+                w[1] = a * a * a + 0.25 * a;
+                dw[0] = 0.0;
+                dw[1] = 3.0 * a * a + 0.25;
+                Ok(())
+            },
+        ),
+    )
+    .unwrap();
+    let mut root = 0.7f64;
+    for _ in 0..60 {
+        root -= (4.0 * root.powi(3) + root - 2.0) / (12.0 * root * root + 1.0);
+    }
+    let mut path = run(&problem, basis, 0.0, 2.0, false);
+    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
+    assert_eq!(path.events().len(), p, "one event per node (basis load)");
+    for e in path.events() {
+        assert!(
+            (e.alpha - root).abs() <= 1e-13,
+            "event at α = {} ({root})",
+            e.alpha
+        );
+        assert_eq!(
+            (e.from, e.to),
+            (fricont::Class::Stick, fricont::Class::SlipPlus)
+        );
+    }
+    let sols = path.solutions_at(1.5).expect("solutions_at");
+    for i in 0..p {
+        assert!((sols[0].state.lambda_t[i] + 0.5).abs() <= 1e-14);
+    }
+    let general = Load::general(
+        2 * p,
+        Box::new(move |a: f64, out: &mut [f64]| -> Result<(), LoadFailure> {
+            out[..p].fill(0.5);
+            out[p..].fill(0.5 * (a * a * a + 0.25 * a));
+            Ok(())
+        }),
+        None,
+    );
+    let path = run(&problem, general, 0.0, 2.0, false);
+    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
+    assert_eq!(path.events().len(), p, "one event per node (general load)");
+    for e in path.events() {
+        assert!(
+            (e.alpha - root).abs() <= 1e-13,
+            "event at α = {} ({root})",
+            e.alpha
+        );
     }
 }
