@@ -228,6 +228,7 @@ fn directional_problem_at_a_vertex_of_many_nodes() {
 /// α = 0 is the directional problem of that point (the path pivots on their classes, see
 /// `Path::pivoted_classes`). Checked against the fixed-α solver started afresh at half
 /// the way to the next event: the same classes and the same λ (1e-10 of the forces).
+/// Every second problem is traced in double-double.
 #[test]
 fn many_nodes_reach_their_friction_limit_together() {
     use fricont::problem::ProblemBuilder;
@@ -262,13 +263,21 @@ fn many_nodes_reach_their_friction_limit_together() {
         };
         let load = || Load::affine(wl(&lam0), wl(&y)).unwrap();
         let wf = faer::Mat::<f64>::from_fn(m, m, |i, j| w[(i, j)]);
+        // Every second problem in double-double (condensed input is otherwise traced in
+        // double where W is well conditioned, as here).
+        let mode = if seed % 2 == 0 {
+            fricont::ExtendedPrecision::On
+        } else {
+            fricont::ExtendedPrecision::Auto
+        };
         let problem = Arc::new(
             ProblemBuilder::condensed(wf)
+                .extended_precision(mode)
                 .friction_uniform(friction)
                 .build()
                 .expect("problem"),
         );
-        let ctx = format!("seed {seed} (p = {p}, F = {friction:.3})");
+        let ctx = format!("seed {seed} (p = {p}, F = {friction:.3}, {mode:?})");
         compare(&ctx, problem.clone(), load, -friction, 1.0);
         // From α = −F: there every λt is still inside its cone on both sides.
         let mut path = run(&problem, load(), -friction, 1.0, false);
