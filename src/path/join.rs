@@ -318,7 +318,8 @@ impl Path {
             // Many nodes at a boundary between two classes at once (identical nodes
             // reaching their friction limit together): a continuation per way along α by
             // pivoting on their classes.
-            if options.iter().all(|o| o.len() <= 2) {
+            let pivoting = options.iter().all(|o| o.len() <= 2);
+            if pivoting {
                 let mut out = Vec::new();
                 for want in [1.0, -1.0] {
                     let Some(cl) =
@@ -330,14 +331,20 @@ impl Path {
                         &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
                     );
                 }
-                if !out.is_empty() {
+                // (none: the relaxed slopes of `continuations_either` may find one)
+                if !out.is_empty() || !relaxed {
                     return Ok(out);
                 }
             }
             return Err(Error::Numerical(format!(
-                "{} nodes are at a class boundary at once at alpha = {:e}: {combos} neighbouring pieces exceed the limit of {MAX_CANDIDATE_PIECES}",
+                "{} nodes are at a class boundary at once at alpha = {:e}: {combos} neighbouring pieces exceed the limit of {MAX_CANDIDATE_PIECES}{}",
                 enumerated.len(),
-                pt.alpha
+                pt.alpha,
+                if pivoting {
+                    ", and pivoting on their classes found no continuation"
+                } else {
+                    ""
+                }
             )));
         }
         let mut out = Vec::new();
