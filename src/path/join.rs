@@ -153,10 +153,10 @@ impl Path {
 
     /// Whether guard `row` (its slope taken along a piece's tangent t) lets the way `s`
     /// along t (±1) into the piece's region at the point: None when it does; Some(true)
-    /// when it is at zero (see [`Tol::at_zero`]; `tols.1` for the nodes of `switching`,
-    /// whose guards are zero by construction, see [`Self::push_candidates`]) and does not
-    /// increase (`relaxed`: decreases beyond its slope threshold); Some(false) when it is
-    /// below zero (the piece does not contain the point).
+    /// when it is at zero (see [`Tol::at_zero`]; `tol_switching` for the nodes of
+    /// `switching`, whose guards are zero by construction, see [`Self::push_candidates`])
+    /// and does not increase (`relaxed`: decreases beyond its slope threshold);
+    /// Some(false) when it is below zero (the piece does not contain the point).
     fn guard_blocks(
         &self,
         row: &GuardRow,
@@ -423,7 +423,10 @@ impl Path {
                 classes[i] = options[k][0];
             }
         }
-        let slot = |i: usize| nodes.iter().position(|&n| n == i);
+        let mut slots = vec![None; classes.len()];
+        for (k, &i) in nodes.iter().enumerate() {
+            slots[i] = Some(k);
+        }
         let mut seen = std::collections::HashSet::new();
         let (mut fewest, mut single) = (usize::MAX, false);
         for _ in 0..4 * nodes.len() + 64 {
@@ -441,7 +444,7 @@ impl Path {
             for row in &table {
                 match self.guard_blocks(row, s, (tol, &tol_switching), nodes, relaxed) {
                     None => {}
-                    Some(true) => match slot(row.guard.node) {
+                    Some(true) => match slots[row.guard.node] {
                         Some(k) if options[k].len() == 2 => blocked.push(k),
                         _ => return None,
                     },
