@@ -338,6 +338,74 @@ fn many_nodes_reach_their_friction_limit_together() {
     );
 }
 
+/// Twenty identical decoupled nodes (W = I/2, condensed), each pressed by
+/// `q_ν = (1 − α)/2` and sheared by `q_t = 3/8`, with F = 1/2. By hand: they slip in +t
+/// from α = 0 (stick would need |λt| = 3/4 ≤ F (1 − α)): `λν = α − 1`, `λt = F λν`,
+/// `dt = 3/8 + λt/2 > 0`; at α = 1 every normal force reaches zero together while each
+/// node still slides (`dt = 3/8`: slip+ or open fit, 2^20 neighbouring pieces), and after
+/// it each is open with `dν = q_ν < 0`, `λ = 0`; backwards, they touch down together.
+#[test]
+fn identical_decoupled_nodes_lift_off_together() {
+    use fricont::problem::ProblemBuilder;
+    let p = 20;
+    let w = faer::Mat::<f64>::from_fn(2 * p, 2 * p, |i, j| if i == j { 0.5 } else { 0.0 });
+    let problem = Arc::new(
+        ProblemBuilder::condensed(w)
+            .friction_uniform(0.5)
+            .build()
+            .expect("problem"),
+    );
+    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
+    q0[..p].fill(0.5);
+    q1[..p].fill(-0.5);
+    q0[p..].fill(0.375);
+    let mut path = run(&problem, Load::affine(q0, q1).unwrap(), 0.0, 2.0, false);
+    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
+    let start = path.start_state().expect("start state");
+    assert!(start.classes.iter().all(|c| *c == fricont::Class::SlipPlus));
+    let ev = path.events();
+    assert_eq!(ev.len(), p, "one event per node");
+    for e in ev {
+        assert!((e.alpha - 1.0).abs() <= 1e-15, "event at α = {}", e.alpha);
+        assert_eq!(
+            (e.from, e.to, e.fold, e.bifurcation),
+            (fricont::Class::SlipPlus, fricont::Class::Open, false, false)
+        );
+    }
+    // Backwards from α = 2 the open nodes touch down together, sliding.
+    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
+    q0[..p].fill(0.5);
+    q1[..p].fill(-0.5);
+    q0[p..].fill(0.375);
+    let back = run(&problem, Load::affine(q0, q1).unwrap(), 2.0, 0.0, false);
+    assert_eq!(back.end_reason(), Some(&fricont::EndReason::Window));
+    assert_eq!(back.events().len(), p, "one event per node (backwards)");
+    for e in back.events() {
+        assert!((e.alpha - 1.0).abs() <= 1e-15, "event at α = {}", e.alpha);
+        assert_eq!(
+            (e.from, e.to),
+            (fricont::Class::Open, fricont::Class::SlipPlus)
+        );
+    }
+    let sols = path.solutions_at(1.5).expect("solutions_at");
+    assert_eq!(sols.len(), 1);
+    assert!(
+        sols[0]
+            .state
+            .classes
+            .iter()
+            .all(|c| *c == fricont::Class::Open)
+    );
+    assert!(
+        sols[0]
+            .state
+            .lambda_n
+            .iter()
+            .chain(&sols[0].state.lambda_t)
+            .all(|v| *v == 0.0)
+    );
+}
+
 /// Twenty identical decoupled nodes (W = I/2, condensed), each pressed by `q_ν = 1/2`
 /// and sheared by `q_t = α/2`, with F = 1/2. By hand: on the all-stick piece `d = 0`
 /// gives `λν = −1`, `λt = −α`, inside the cone (|λt| < −F λν) for α < 1/2; at α = 1/2
