@@ -338,6 +338,18 @@ fn many_nodes_reach_their_friction_limit_together() {
     );
 }
 
+/// `p` identical decoupled nodes: condensed W = I/2, F = 1/2.
+fn decoupled_nodes(p: usize) -> Arc<Problem> {
+    use fricont::problem::ProblemBuilder;
+    let w = faer::Mat::<f64>::from_fn(2 * p, 2 * p, |i, j| if i == j { 0.5 } else { 0.0 });
+    Arc::new(
+        ProblemBuilder::condensed(w)
+            .friction_uniform(0.5)
+            .build()
+            .expect("problem"),
+    )
+}
+
 /// Twenty identical decoupled nodes (W = I/2, condensed), each pressed by
 /// `q_ν = (1 − α)/2` and sheared by `q_t = 3/8`, with F = 1/2. By hand: they slip in +t
 /// from α = 0 (stick would need |λt| = 3/4 ≤ F (1 − α)): `λν = α − 1`, `λt = F λν`,
@@ -346,20 +358,16 @@ fn many_nodes_reach_their_friction_limit_together() {
 /// it each is open with `dν = q_ν < 0`, `λ = 0`; backwards, they touch down together.
 #[test]
 fn identical_decoupled_nodes_lift_off_together() {
-    use fricont::problem::ProblemBuilder;
     let p = 20;
-    let w = faer::Mat::<f64>::from_fn(2 * p, 2 * p, |i, j| if i == j { 0.5 } else { 0.0 });
-    let problem = Arc::new(
-        ProblemBuilder::condensed(w)
-            .friction_uniform(0.5)
-            .build()
-            .expect("problem"),
-    );
-    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
-    q0[..p].fill(0.5);
-    q1[..p].fill(-0.5);
-    q0[p..].fill(0.375);
-    let mut path = run(&problem, Load::affine(q0, q1).unwrap(), 0.0, 2.0, false);
+    let problem = decoupled_nodes(p);
+    let load = || {
+        let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
+        q0[..p].fill(0.5);
+        q1[..p].fill(-0.5);
+        q0[p..].fill(0.375);
+        Load::affine(q0, q1).unwrap()
+    };
+    let mut path = run(&problem, load(), 0.0, 2.0, false);
     assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
     let start = path.start_state().expect("start state");
     assert!(start.classes.iter().all(|c| *c == fricont::Class::SlipPlus));
@@ -373,11 +381,7 @@ fn identical_decoupled_nodes_lift_off_together() {
         );
     }
     // Backwards from α = 2 the open nodes touch down together, sliding.
-    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
-    q0[..p].fill(0.5);
-    q1[..p].fill(-0.5);
-    q0[p..].fill(0.375);
-    let back = run(&problem, Load::affine(q0, q1).unwrap(), 2.0, 0.0, false);
+    let back = run(&problem, load(), 2.0, 0.0, false);
     assert_eq!(back.end_reason(), Some(&fricont::EndReason::Window));
     assert_eq!(back.events().len(), p, "one event per node (backwards)");
     for e in back.events() {
@@ -414,15 +418,8 @@ fn identical_decoupled_nodes_lift_off_together() {
 /// basis and a general load.
 #[test]
 fn identical_decoupled_nodes_slip_together() {
-    use fricont::problem::ProblemBuilder;
     let p = 20;
-    let w = faer::Mat::<f64>::from_fn(2 * p, 2 * p, |i, j| if i == j { 0.5 } else { 0.0 });
-    let problem = Arc::new(
-        ProblemBuilder::condensed(w)
-            .friction_uniform(0.5)
-            .build()
-            .expect("problem"),
-    );
+    let problem = decoupled_nodes(p);
     let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
     q0[..p].fill(0.5);
     q1[p..].fill(0.5);
