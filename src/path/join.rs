@@ -317,14 +317,18 @@ impl Path {
         if combos > MAX_CANDIDATE_PIECES {
             // Many nodes at a boundary between two classes at once (identical nodes
             // reaching their friction limit together): a continuation per way along α by
-            // pivoting on their classes.
-            let pivoting = options.iter().all(|o| o.len() <= 2);
+            // pivoting on their classes (those at the vertex from the directional problem).
+            let pivoting = enumerated.iter().all(|&k| options[k].len() <= 2);
             if pivoting {
                 let mut out = Vec::new();
                 for want in [1.0, -1.0] {
-                    let Some(cl) =
-                        self.pivoted_classes(pt, fixed, nodes, &options, (want, relaxed), &tol)
-                    else {
+                    let Some(cl) = self.pivoted_classes(
+                        pt,
+                        fixed,
+                        (nodes, &options, &is_vertex),
+                        (want, relaxed),
+                        &tol,
+                    ) else {
                         continue;
                     };
                     self.push_candidates(
@@ -395,7 +399,9 @@ impl Path {
     /// The classes of the piece that continues the path from `pt` with α moving along
     /// `want` (±1), where more nodes are at a boundary between two classes than
     /// [`MAX_CANDIDATE_PIECES`] lets [`Self::continuations`] enumerate: `nodes` fit the
-    /// classes `options` (one or two each), every other node keeps its class in `fixed`.
+    /// classes `options` (one or two each, or all four at a zero-force vertex, `vertex`:
+    /// those take theirs from [`Self::directional_classes`] with the others' classes at
+    /// each step), every other node keeps its class in `fixed`.
     /// Which of the two classes a node takes is a linear complementarity problem in the
     /// rates (the directional problem of the point, as at a zero-force vertex): a node
     /// whose guard at zero decreases along the piece's tangent must take its other class.
@@ -410,8 +416,7 @@ impl Path {
         &self,
         pt: &Point,
         fixed: &[Class],
-        nodes: &[usize],
-        options: &[Vec<Class>],
+        (nodes, options, vertex): (&[usize], &[Vec<Class>], &[bool]),
         (want, relaxed): (f64, bool),
         tol: &Tol,
     ) -> Option<Vec<Class>> {
@@ -430,6 +435,14 @@ impl Path {
         let mut seen = std::collections::HashSet::new();
         let (mut fewest, mut single) = (usize::MAX, false);
         for _ in 0..4 * nodes.len() + 64 {
+            if vertex.iter().any(|&v| v) {
+                let frozen: Vec<Option<Class>> = classes
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &c)| (!slots[i].is_some_and(|k| vertex[k])).then_some(c))
+                    .collect();
+                classes = self.directional_classes(pt, &frozen, want)?;
+            }
             if !seen.insert(classes.clone()) {
                 return None;
             }
