@@ -423,22 +423,40 @@ fn identical_decoupled_nodes_slip_together() {
     let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
     q0[..p].fill(0.5);
     q1[p..].fill(0.5);
-    let mut path = run(&problem, Load::affine(q0, q1).unwrap(), 0.0, 2.0, false);
-    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
-    let ev = path.events();
-    assert_eq!(ev.len(), p, "one event per node");
-    for e in ev {
-        assert!((e.alpha - 0.5).abs() <= 1e-15, "event at α = {}", e.alpha);
+    // Every node stick → slip+ at `at`, the path to the window's end.
+    let slip_together = |path: &Path, at: f64, tol: f64, what: &str| {
         assert_eq!(
-            (e.from, e.to, e.fold, e.bifurcation),
-            (
-                fricont::Class::Stick,
-                fricont::Class::SlipPlus,
-                false,
-                false
-            )
+            path.end_reason(),
+            Some(&fricont::EndReason::Window),
+            "{what}"
         );
-    }
+        assert_eq!(path.events().len(), p, "one event per node ({what})");
+        for e in path.events() {
+            assert!(
+                (e.alpha - at).abs() <= tol,
+                "{what}: event at α = {} ({at})",
+                e.alpha
+            );
+            assert_eq!(
+                (e.from, e.to, e.fold, e.bifurcation),
+                (
+                    fricont::Class::Stick,
+                    fricont::Class::SlipPlus,
+                    false,
+                    false
+                ),
+                "{what}"
+            );
+        }
+    };
+    let mut path = run(
+        &problem,
+        Load::affine(q0.clone(), q1.clone()).unwrap(),
+        0.0,
+        2.0,
+        false,
+    );
+    slip_together(&path, 0.5, 1e-15, "affine load");
     let sols = path.solutions_at(1.0).expect("solutions_at");
     assert_eq!(sols.len(), 1);
     for i in 0..p {
@@ -448,9 +466,6 @@ fn identical_decoupled_nodes_slip_together() {
     // The same under the basis load `q0 + φ(α) q1`, φ(α) = α³ + α/4, and as a general
     // load: the nodes slip together where φ = 1/2, at the root of 4α³ + α − 2 (by
     // Newton here).
-    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
-    q0[..p].fill(0.5);
-    q1[p..].fill(0.5);
     let basis = Load::basis(
         vec![q0, q1],
         Box::new(
@@ -469,19 +484,7 @@ fn identical_decoupled_nodes_slip_together() {
         root -= (4.0 * root.powi(3) + root - 2.0) / (12.0 * root * root + 1.0);
     }
     let mut path = run(&problem, basis, 0.0, 2.0, false);
-    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
-    assert_eq!(path.events().len(), p, "one event per node (basis load)");
-    for e in path.events() {
-        assert!(
-            (e.alpha - root).abs() <= 1e-13,
-            "event at α = {} ({root})",
-            e.alpha
-        );
-        assert_eq!(
-            (e.from, e.to),
-            (fricont::Class::Stick, fricont::Class::SlipPlus)
-        );
-    }
+    slip_together(&path, root, 1e-13, "basis load");
     let sols = path.solutions_at(1.5).expect("solutions_at");
     for i in 0..p {
         assert!((sols[0].state.lambda_t[i] + 0.5).abs() <= 1e-14);
@@ -496,15 +499,7 @@ fn identical_decoupled_nodes_slip_together() {
         None,
     );
     let path = run(&problem, general, 0.0, 2.0, false);
-    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
-    assert_eq!(path.events().len(), p, "one event per node (general load)");
-    for e in path.events() {
-        assert!(
-            (e.alpha - root).abs() <= 1e-13,
-            "event at α = {} ({root})",
-            e.alpha
-        );
-    }
+    slip_together(&path, root, 1e-13, "general load");
 }
 
 /// The nodes of [`identical_decoupled_nodes_slip_together`] (20, reaching `λt = F λν` at

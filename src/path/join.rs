@@ -423,19 +423,18 @@ impl Path {
         let scale = self.force_scale(pt);
         let tol_switching = tol.clone().approximate();
         let mut classes = fixed.to_vec();
+        let mut slots = vec![None; classes.len()];
         for (k, &i) in nodes.iter().enumerate() {
             if !options[k].contains(&classes[i]) {
                 classes[i] = options[k][0];
             }
-        }
-        let mut slots = vec![None; classes.len()];
-        for (k, &i) in nodes.iter().enumerate() {
             slots[i] = Some(k);
         }
+        let any_vertex = vertex.iter().any(|&v| v);
         let mut seen = std::collections::HashSet::new();
         let (mut fewest, mut single) = (usize::MAX, false);
         for _ in 0..4 * nodes.len() + 64 {
-            if vertex.iter().any(|&v| v) {
+            if any_vertex {
                 let frozen: Vec<Option<Class>> = classes
                     .iter()
                     .enumerate()
