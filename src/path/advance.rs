@@ -483,6 +483,7 @@ impl Path {
         // (1e-4 of λ on the p = 1920 strip), the double-precision point made a guard
         // crossed at the piece's entry and the exit went backwards.
         let refined = self.refine_piece(cur);
+        self.refined = refined.clone().map(|r| (cur.alpha, cur.classes.clone(), r));
         // Set again below where this piece's exit is taken on its refined line.
         self.carried = None;
         let (lam0, t, rate) = match &refined {

@@ -265,6 +265,11 @@ pub struct Path {
     /// In extended precision, the last straight piece's exit on its refined line (see
     /// `polish::CarriedPoint`).
     carried: Option<polish::CarriedPoint>,
+    /// In extended precision, the current straight piece as its exit refined it (see
+    /// `advance::exit_linear`), with the piece's entry α and classes: the transition
+    /// point's roots (`join::transit`) are taken on the same line instead of refining
+    /// the piece a second time.
+    refined: Option<(f64, Vec<Class>, polish::RefinedPiece)>,
 }
 
 /// The traced data and the current position.
@@ -956,6 +961,7 @@ impl Path {
             graph_step: Cell::new(None),
             resolved: RefCell::new(Vec::new()),
             carried: None,
+            refined: None,
         })
     }
 
@@ -2144,6 +2150,7 @@ impl Path {
             }
         }
         let cur = self.trace.as_ref().expect("started").cur.clone();
+        self.refined = None;
         let vertical = cur.scales.is_vertical(&cur.t);
         let exit = if self.load.is_affine() || vertical {
             self.exit_linear(&cur)?

@@ -362,6 +362,7 @@ impl Refiner<'_> {
 /// A straight piece refined in double-double ([`Path::refine_piece`]): its point at the
 /// entry α and its rate dλ/dα, each with its d, and the four rounded to double (in that
 /// order).
+#[derive(Clone)]
 pub(super) struct RefinedPiece {
     lam_e: DdVec,
     d_e: DdVec,
@@ -719,13 +720,19 @@ impl Path {
     /// In extended precision, the α where each of `forms` (guards of the straight piece
     /// `cur`) reaches zero on the piece's line refined in double-double (`λ_e + (α − α_e)
     /// λ'`, its d likewise), rounded to double: None for a form constant along the piece.
-    /// None (for all) as for [`Self::refine_piece`].
+    /// None (for all) as for [`Self::refine_piece`]. The line is the one the piece's exit
+    /// was refined on where that is kept (see `Path::refined`): at p = 1920 on the strips,
+    /// half of the transition points have such forms, and refining their piece again
+    /// (four solves and a product with W in double-double) was a third of a transition.
     pub(super) fn refined_roots(
         &mut self,
         cur: &CurrentPiece,
         forms: &[LinForm],
     ) -> Option<Vec<Option<f64>>> {
-        let r = self.refine_piece(cur)?;
+        let r = match self.refined.take() {
+            Some((alpha, classes, r)) if alpha == cur.alpha && classes == cur.classes => r,
+            _ => self.refine_piece(cur)?,
+        };
         Some(
             forms
                 .iter()
