@@ -31,8 +31,15 @@ use crate::piece::LinForm;
 /// stayed in double, up to 5e-6 in α off).
 const MAX_ROUNDS: usize = 64;
 /// A correction this small relative to the solution's scale (max|x| or the data's force
-/// scale, see [`Refiner::refine_all`]) ends the refinement.
-const CONVERGED: f64 = 1e-24;
+/// scale, see [`Refiner::refine_all`]) ends the refinement, as does one whose successor
+/// (predicted from the contraction) is. Where rounds cost anything, the pieces are
+/// ill-conditioned (κ ≳ 1e10, each round contracting by κ ε): there the data carried in
+/// double-double (W as `W + W_lo`, ~1e-32 of itself) determine the solution only to about
+/// κ · 1e-32 ≳ 1e-22 of itself, and a rate that close moves a guard's root by 1e-17 of
+/// the piece's length even where the guard's slope cancels to 1e-5 of its terms. It was
+/// 1e-24: on the p = 1920 strip (rounds contracting by 5e-6, corrections 1e-7, 5e-13,
+/// 4e-18, 2e-23 of the rate) that took a fourth round, a quarter of a transition.
+const CONVERGED: f64 = 1e-22;
 /// A refinement that stops contracting is kept when its last correction is this small
 /// (relative to the solution's scale).
 const STALLED: f64 = 1e-20;
@@ -328,7 +335,7 @@ impl Refiner<'_> {
                 // the solution, step² / size (a double-precision solve is off by about
                 // cond · ε of it, and each round contracts by about cond · ε), so a first
                 // round ends the refinement only where the correction is within about
-                // √CONVERGED (1e-12) of the solution. It used to end it where the
+                // √CONVERGED (1e-11) of the solution. It used to end it where the
                 // correction was within 1e-4: on two stacked blocks (p = 640, F = 0.3,
                 // κ(W) = 2.3e7) a rate corrected by 5.7e-7 of itself in one round kept
                 // enough error to move the slope of a guard that is a small difference of
