@@ -78,6 +78,10 @@ impl DdVec {
         self.hi[k] = v.hi;
         self.lo[k] = v.lo;
     }
+    /// Each entry rounded to double.
+    fn rounded(&self) -> Vec<f64> {
+        (0..self.hi.len()).map(|k| self.get(k).to_f64()).collect()
+    }
 }
 
 /// `d = W x + c` in double-double for each pair `(x, c)`: one pass over W for all of
@@ -399,6 +403,13 @@ pub(super) struct CarriedPoint {
 /// See [`CarriedPoint`].
 const CARRY_REFRESH: usize = 8;
 
+impl CarriedPoint {
+    /// λ and d of the point, rounded to double.
+    pub(super) fn rounded(&self) -> (Vec<f64>, Vec<f64>) {
+        (self.lam.rounded(), self.d.rounded())
+    }
+}
+
 impl RefinedPiece {
     /// The point on the refined line at `alpha` (the piece entered at `alpha_e`), to be
     /// carried to the next piece (see [`CarriedPoint`]).
@@ -709,8 +720,12 @@ impl Path {
         let mut refined = refined.into_iter();
         let (lam_e, d_e) = refined.next()?;
         let (lam_1, d_1) = refined.next()?;
-        let round = |v: &DdVec| -> Vec<f64> { (0..m).map(|k| v.get(k).to_f64()).collect() };
-        let rounded = [round(&lam_e), round(&d_e), round(&lam_1), round(&d_1)];
+        let rounded = [
+            lam_e.rounded(),
+            d_e.rounded(),
+            lam_1.rounded(),
+            d_1.rounded(),
+        ];
         rounded
             .iter()
             .all(|v| v.iter().all(|x| x.is_finite()))
