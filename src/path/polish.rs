@@ -675,11 +675,12 @@ impl Path {
         let ta = cur.t[m];
         let rate0: Vec<f64> = cur.t[..m].iter().map(|v| v / ta).collect();
         // The last piece's exit on its refined line where this piece starts there, with
-        // its d (see CarriedPoint); else the piece's own point in double.
+        // its d (see CarriedPoint; every CARRY_REFRESH-th piece d afresh from W); else the
+        // piece's own point in double.
         let carried = self
             .carried
             .as_ref()
-            .filter(|cp| cp.alpha == cur.alpha && cp.hops < CARRY_REFRESH)
+            .filter(|cp| cp.alpha == cur.alpha)
             .cloned();
         let refine = |x0: DdVec, d0: Option<DdVec>| {
             r.refine_all_known(
@@ -710,9 +711,18 @@ impl Path {
                         }
                     }
                 }
-                refine(lam, Some(d))
-                    .map(|v| (v, cp.hops))
-                    .or_else(from_start)
+                // The refresh recomputes d from the carried λ. (It used to start from the
+                // piece's point in double, 1e-7 off on the p = 1920 strip, refined to the
+                // target only, where the carried λ is within a rounding of the last line:
+                // a guard that is a small difference of large terms, a sliding node's
+                // tangential displacement of 2.9e-13 there with a slope of 1.4e-9 against
+                // rates of d up to 8.8, takes its root from the point's last digits.)
+                let (d, hops) = if cp.hops < CARRY_REFRESH {
+                    (Some(d), cp.hops)
+                } else {
+                    (None, 0)
+                };
+                refine(lam, d).map(|v| (v, hops)).or_else(from_start)
             }
             None => from_start(),
         };
