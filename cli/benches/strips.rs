@@ -6,6 +6,7 @@
 //! FRICONT_BENCH_FRESH=480 cargo bench --bench strips   # also fresh factorisations up to p = 480
 //! FRICONT_BENCH_EXTENDED=on cargo bench --bench strips -- 1920   # extended precision on|off (default auto)
 //! FRICONT_BENCH_THREADS=2 cargo bench --bench strips -- 1920       # the problem's threads (default 1)
+//! FRICONT_BENCH_REPS=3 cargo bench --bench strips -- 480 1920      # each strip traced 3 times
 //! ```
 //!
 //! Each strip is the rectangle generator's press-shear case with `p + 1 × 4` nodes on
@@ -17,7 +18,12 @@
 //! was carried in extended precision (`ext`: W refined and transition points polished in
 //! double-double; the set-up time includes the refinement). With
 //! `FRICONT_BENCH_FRESH=P`, strips with p ≤ P are traced a second time with a fresh
-//! factorisation of every piece (the reference tracer) for the ratio.
+//! factorisation of every piece (the reference tracer) for the ratio. With
+//! `FRICONT_BENCH_REPS=N` each strip is set up and traced N times (a row each), and a
+//! summary gives each size's least and median time per transition and their ratios to the
+//! first size's: on this shared machine a short trace (p = 480: 2 s) varies by up to
+//! 1.7× from run to run, a long one (p = 1920: 200 s) by a few percent, so a growth taken
+//! from single traces says as much about the moment as about the code.
 
 use std::path::{Path as FsPath, PathBuf};
 use std::sync::Arc;
@@ -111,6 +117,11 @@ fn main() {
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(0);
+    let reps: usize = std::env::var("FRICONT_BENCH_REPS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1)
+        .max(1);
     let tmp = std::env::temp_dir().join("fricont-bench-strips");
     println!(
         "{:>6} {:>7} {:>11} {:>9} {:>9} {:>9} {:>12} {:>8} {:>9} {:>4}  end",
@@ -125,6 +136,8 @@ fn main() {
         "peak MiB",
         "ext"
     );
+    // (p, least and median ms per transition of the updated tracer over the repetitions)
+    let mut summary: Vec<(usize, f64, f64)> = Vec::new();
     for &p in &sizes {
         let dir = strip(&tmp, p);
         let case = CaseData::read_dir(&dir).expect("read");
@@ -133,13 +146,32 @@ fn main() {
             runs.push(("fresh", true));
         }
         for (name, fresh) in runs {
-            let (tr, end, setup, start, secs, refact, ext) = trace(&case, fresh);
+            let mut per: Vec<f64> = Vec::new();
+            for _ in 0..reps {
+                let (tr, end, setup, start, secs, refact, ext) = trace(&case, fresh);
+                let ms = 1e3 * (secs - start) / tr.max(1) as f64;
+                per.push(ms);
+                println!(
+                    "{p:>6} {:>7} {tr:>11} {setup:>9.2} {start:>9.2} {secs:>9.2} {ms:>12.2} {refact:>8} {:>9.0} {:>4}  {end} ({name})",
+                    case.a.nrows(),
+                    peak_mib().unwrap_or(f64::NAN),
+                    if ext { "yes" } else { "no" }
+                );
+            }
+            if !fresh {
+                per.sort_by(f64::total_cmp);
+                summary.push((p, per[0], per[per.len() / 2]));
+            }
+        }
+    }
+    if reps > 1 {
+        let (p0, least0, median0) = summary[0];
+        println!("ms per transition over {reps} traces each (least, median; ratio to p = {p0}):");
+        for &(p, least, median) in &summary {
             println!(
-                "{p:>6} {:>7} {tr:>11} {setup:>9.2} {start:>9.2} {secs:>9.2} {:>12.2} {refact:>8} {:>9.0} {:>4}  {end} ({name})",
-                case.a.nrows(),
-                1e3 * (secs - start) / tr.max(1) as f64,
-                peak_mib().unwrap_or(f64::NAN),
-                if ext { "yes" } else { "no" }
+                "{p:>6} {least:>9.2} {median:>9.2}  ({:.1}x, {:.1}x)",
+                least / least0,
+                median / median0
             );
         }
     }
