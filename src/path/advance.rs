@@ -646,7 +646,7 @@ impl Path {
                 // the double-precision point).
                 let polished = refined
                     .as_ref()
-                    .and_then(|r| self.polish_exit(cur, r, &decreasing));
+                    .and_then(|r| self.polish_exit(cur, r, &decreasing).map(|exit| (r, exit)));
                 // The exit is then the refined line's point at that α rounded to double,
                 // with its d there: the transition point's gaps without a product with W
                 // (one pass over W, 6 % of a transition at p = 1920). d is that of the
@@ -654,19 +654,15 @@ impl Path {
                 // as a product's own rounding is.
                 let mut primed = None;
                 let (lam, alpha, g) = match polished {
-                    Some((l2, a2, g2)) if super::polish::near(&l2, &lam, self.force_scale(&pt)) => {
+                    Some((r, (l2, a2, g2)))
+                        if super::polish::near(&l2, &lam, self.force_scale(&pt)) =>
+                    {
                         on_line = None;
-                        let cp = refined.as_ref().map(|r| r.carried_at(cur.alpha, a2));
-                        let l2 = match &cp {
-                            Some(cp) => {
-                                let (l, d) = cp.rounded();
-                                primed = Some(d);
-                                l
-                            }
-                            None => l2,
-                        };
-                        self.carried = cp;
-                        (l2, a2, g2)
+                        let cp = r.carried_at(cur.alpha, a2);
+                        let (l, d) = cp.rounded();
+                        primed = Some(d);
+                        self.carried = Some(cp);
+                        (l, a2, g2)
                     }
                     _ => (lam, alpha, g),
                 };

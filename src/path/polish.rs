@@ -698,32 +698,30 @@ impl Path {
         let from_start = || refine(DdVec::from(&start), None).map(|v| (v, 0));
         let refined = match carried {
             Some(cp) => {
-                let (mut lam, mut d) = (cp.lam, cp.d);
-                // A node open on this piece has λ = 0 exactly, as its solves give it: on
-                // the last line a node that opens here is at its root, within rounding of
-                // zero (d then corrected by W times the change, O(m) per row).
-                let p = self.problem.p();
-                let open = (0..p).filter(|&i| cur.classes[i] == Class::Open);
-                for row in open.flat_map(|i| [i, p + i]) {
-                    let v = lam.get(row).to_f64();
-                    if v != 0.0 || lam.lo[row] != 0.0 {
-                        lam.set(row, Dd::ZERO);
-                        for (k, wk) in r.w.col(row).iter().enumerate() {
-                            d.set(k, d.get(k).add_f64(-wk * v));
-                        }
-                    }
-                }
                 // The refresh recomputes d from the carried λ. (It used to start from the
                 // piece's point in double, 1e-7 off on the p = 1920 strip, refined to the
                 // target only, where the carried λ is within a rounding of the last line:
                 // a guard that is a small difference of large terms, a sliding node's
                 // tangential displacement of 2.9e-13 there with a slope of 1.4e-9 against
                 // rates of d up to 8.8, takes its root from the point's last digits.)
-                let (d, hops) = if cp.hops < CARRY_REFRESH {
-                    (Some(d), cp.hops)
-                } else {
-                    (None, 0)
-                };
+                let (mut lam, mut d) = (cp.lam, (cp.hops < CARRY_REFRESH).then_some(cp.d));
+                let hops = if d.is_some() { cp.hops } else { 0 };
+                // A node open on this piece has λ = 0 exactly, as its solves give it: on
+                // the last line a node that opens here is at its root, within rounding of
+                // zero (a carried d then corrected by W times the change, O(m) per row).
+                let p = self.problem.p();
+                let open = (0..p).filter(|&i| cur.classes[i] == Class::Open);
+                for row in open.flat_map(|i| [i, p + i]) {
+                    let v = lam.get(row).to_f64();
+                    if v != 0.0 || lam.lo[row] != 0.0 {
+                        lam.set(row, Dd::ZERO);
+                        if let Some(d) = d.as_mut() {
+                            for (k, wk) in r.w.col(row).iter().enumerate() {
+                                d.set(k, d.get(k).add_f64(-wk * v));
+                            }
+                        }
+                    }
+                }
                 refine(lam, d).map(|v| (v, hops)).or_else(from_start)
             }
             None => from_start(),
