@@ -610,3 +610,53 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
         }
     }
 }
+
+/// A mirror-symmetric body of 1002 contact nodes in double ([`common::symmetric_fe_case`]
+/// seed 51, 1001 × 2 elements, F = 5) under the oscillating basis load of
+/// [`oscillating_load`], over its first 4300 events (α from 0 to 0.0645). At α = 0.0634
+/// one node of a mirrored pair (node 948) lifted off alone, its image's λν at zero by
+/// rounding only, onto a piece of length 0; the only piece found at its end was the one
+/// before it walked backwards, and the path took it: a fold that the trace in
+/// double-double does not have (it has none in the load's two periods), then 2000 events
+/// walked back along the path's own, to a closed loop. The way the path came across
+/// pieces a rounding long is never a continuation: the path must reach the window's end
+/// with no fold and no bifurcation flagged, every event mirrored (the body's symmetry:
+/// the same α to 1e-9, S+ and S− swapped), the centre node never slipping. (Over the two
+/// periods the trace in double now has the 14,432 events of double-double, α within
+/// 1e-8: a scratch run of `larger_mirror_symmetric_bodies_in_double_match_extended_precision`
+/// on this body, 5 minutes.)
+#[test]
+fn a_mirrored_pair_lifting_off_in_double_is_not_a_fold() {
+    let nx = 1001;
+    let ctx = "seed 51 (nx = 1001, ny = 2, F = 5, oscillating, double)";
+    let case = common::symmetric_fe_case(51, nx, 2, 5.0);
+    let problem = case
+        .data
+        .builder()
+        .extended_precision(fricont::ExtendedPrecision::Off)
+        .build()
+        .expect("problem");
+    let (load, _) = oscillating_load(&case);
+    let mut path =
+        Path::new(Arc::new(problem), load, PathOptions::window(0.0, 0.0645)).expect("path");
+    path.start(0.0, None).expect("start");
+    path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
+    assert_eq!(path.end_reason(), Some(&EndReason::Window), "{ctx}");
+    if let Some(e) = path.events().iter().find(|e| e.fold || e.bifurcation) {
+        panic!(
+            "{ctx}: event {} (node {} {} -> {} at α = {:e}) flagged as a fold or bifurcation",
+            e.index,
+            e.node + 1,
+            e.from,
+            e.to,
+            e.alpha
+        );
+    }
+    let ev: Vec<(f64, usize, Class, Class)> = path
+        .events()
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect();
+    let pairs = assert_mirrored(ctx, &ev, nx);
+    assert!(pairs >= 4000, "{ctx}: {pairs} mirrored events");
+}

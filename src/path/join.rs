@@ -636,39 +636,18 @@ impl Path {
         let back = Some((cur.classes.as_slice(), cur.t.as_slice()));
         let usual = Widen::USUAL;
         let mut blockers = Vec::new();
-        // A node that fits no class at the usual thresholds may fit one at the widened
-        // ones below: the error is returned only where those find no continuation either.
-        let (mut cands, mut unfit) = match self.continuations_either(
-            &pt,
-            &cur.classes,
-            &nodes,
-            back,
-            &mut blockers,
-            usual,
-        ) {
-            Ok(cands) => (cands, None),
-            Err(e) => (Vec::new(), Some(e)),
-        };
-        // A node that the way in found clear of zero (its guard crossing a step beyond
-        // `zero_tol` along the old piece) may be at zero and leaving along every
-        // neighbouring piece: it switches here too. Transitions a rounding apart look like
-        // that: mirrored nodes of a symmetric body in double, whose W is symmetric to
-        // rounding only, crossed 9.6e-12 apart in arclength (zero_tol 1e-11), and no piece
-        // with one of them switching continued the path.
-        blockers.retain(|i| !nodes.contains(i));
-        if cands.is_empty() && !blockers.is_empty() {
-            nodes.append(&mut blockers);
-            nodes.sort_unstable();
-            nodes.dedup();
-            cands =
-                self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, usual)?;
-        }
-        // After pieces a rounding long (transitions a rounding apart, as above), the pieces
-        // before them contain the point too, within the thresholds, and walked backwards
-        // they enter their regions: that is the way the path came, not a branch (mirrored
-        // nodes in double were flagged as bifurcations, one and two pieces back). Only
-        // across such pieces: a path that comes back to a bifurcation point along pieces
-        // of some length may go on along one it walked the other way.
+        // After pieces a rounding long (transitions a rounding apart, see below), the
+        // pieces before them contain the point too, within the thresholds, and walked
+        // backwards they enter their regions: that is the way the path came, neither a
+        // branch nor a continuation, and it is never taken. Mirrored nodes in double were
+        // flagged as bifurcations, one and two pieces back; and where that walk back was
+        // the only piece found (a symmetric body of 1002 contact nodes in double, F = 5,
+        // under an oscillating load: one node of a mirrored pair lifted off alone, on a
+        // piece of length 0, its image's λν at zero by rounding), the path took it as a
+        // fold and walked its own events back for 2000 more, to a closed loop; without
+        // it, the retries below switch the image too, as double-double does. Only across
+        // such pieces: a path that comes back to a bifurcation point along pieces of some
+        // length may go on along one it walked the other way.
         let recent: Vec<(Vec<Class>, i8)> = {
             let tiny = |a0: f64, a1: f64, l0: &[f64], l1: &[f64]| {
                 let scale = inf_norm(l0).max(inf_norm(l1));
@@ -698,12 +677,42 @@ impl Path {
                     cd.classes == *classes && t_alpha * f64::from(*direction) < 0.0
                 })
             };
-            if cands.len() > 1 && cands.iter().any(|cd| !retraces(cd)) {
-                cands.retain(|cd| !retraces(cd));
-            }
+            cands.retain(|cd| !retraces(cd));
             cands
         };
-        cands = without_retrace(cands);
+        // A node that fits no class at the usual thresholds may fit one at the widened
+        // ones below: the error is returned only where those find no continuation either.
+        let (mut cands, mut unfit) = match self.continuations_either(
+            &pt,
+            &cur.classes,
+            &nodes,
+            back,
+            &mut blockers,
+            usual,
+        ) {
+            Ok(cands) => (without_retrace(cands), None),
+            Err(e) => (Vec::new(), Some(e)),
+        };
+        // A node that the way in found clear of zero (its guard crossing a step beyond
+        // `zero_tol` along the old piece) may be at zero and leaving along every
+        // neighbouring piece: it switches here too. Transitions a rounding apart look like
+        // that: mirrored nodes of a symmetric body in double, whose W is symmetric to
+        // rounding only, crossed 9.6e-12 apart in arclength (zero_tol 1e-11), and no piece
+        // with one of them switching continued the path.
+        blockers.retain(|i| !nodes.contains(i));
+        if cands.is_empty() && !blockers.is_empty() {
+            nodes.append(&mut blockers);
+            nodes.sort_unstable();
+            nodes.dedup();
+            cands = without_retrace(self.continuations_either(
+                &pt,
+                &cur.classes,
+                &nodes,
+                back,
+                &mut blockers,
+                usual,
+            )?);
+        }
         // A single continuation at the usual thresholds that the data do not determine: a
         // switching node fits other classes where no displacement row's threshold is
         // below how far the data determine q (`determined`). On a
