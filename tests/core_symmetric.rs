@@ -660,3 +660,69 @@ fn a_mirrored_pair_lifting_off_in_double_is_not_a_fold() {
     let pairs = assert_mirrored(ctx, &ev, nx);
     assert!(pairs >= 4000, "{ctx}: {pairs} mirrored events");
 }
+
+/// A mirror-symmetric body of 660 contact nodes ([`common::symmetric_fe_case`] seed 107,
+/// 659 × 3 elements, F = 5) under the oscillating basis load of [`oscillating_load`]: in
+/// double-double the path stops after 176 events at a non-smooth bifurcation (node 89
+/// and its image 572 reach their cone's edge together, three pieces continue, two of
+/// them mirror images keeping the orientation). In double the two reached it 2.1e-13
+/// apart (3.3 times the usual threshold; the data determine the forces to about κ(W)
+/// times the condensation's error, more than that): node 89 switched alone and the path
+/// went on along one of the asymmetric branches for 323 more events (nine folds), with no
+/// flag. The trace in double must stop where double-double does: the same events (nodes
+/// and classes; α to 1e-8), the same stop (α to 1e-8) and branches (their classes).
+#[test]
+fn a_symmetric_bifurcation_in_double_is_not_decided_by_rounding() {
+    let nx = 659;
+    let case = common::symmetric_fe_case(107, nx, 3, 5.0);
+    let trace = |mode: fricont::ExtendedPrecision| {
+        let ctx = format!("seed 107 (nx = 659, ny = 3, F = 5, oscillating), {mode:?}");
+        let problem = case
+            .data
+            .builder()
+            .extended_precision(mode)
+            .build()
+            .expect("problem");
+        let (load, a1) = oscillating_load(&case);
+        let mut path =
+            Path::new(Arc::new(problem), load, PathOptions::window(0.0, a1)).expect("path");
+        path.start(0.0, None).expect("start");
+        path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
+        assert_eq!(path.end_reason(), Some(&EndReason::Bifurcation), "{ctx}");
+        let ev: Vec<(f64, usize, Class, Class)> = path
+            .events()
+            .iter()
+            .map(|e| (e.alpha, e.node, e.from, e.to))
+            .collect();
+        let branches: BTreeSet<Vec<Class>> =
+            path.branches().iter().map(|b| b.classes.clone()).collect();
+        let stop = path.current().expect("state at the stop").alpha;
+        (ev, stop, branches, ctx)
+    };
+    let (refined, stop_r, branches_r, _) = trace(fricont::ExtendedPrecision::On);
+    let (double, stop_d, branches_d, ctx) = trace(fricont::ExtendedPrecision::Off);
+    assert_eq!(
+        refined.len(),
+        176,
+        "double-double: {} events",
+        refined.len()
+    );
+    assert_mirrored(&ctx, &double, nx);
+    assert_eq!(double.len(), refined.len(), "{ctx}: numbers of events");
+    // (mirrored nodes switch a rounding apart in double: matched by node and classes)
+    for &(a, i, from, to) in &double {
+        assert!(
+            refined
+                .iter()
+                .any(|&(b, j, f, t)| (j, f, t) == (i, from, to)
+                    && (a - b).abs() <= 1e-8 * a.abs().max(1.0)),
+            "{ctx}: node {} {from} -> {to} at α = {a}: not in double-double",
+            i + 1
+        );
+    }
+    assert!(
+        (stop_d - stop_r).abs() <= 1e-8 * stop_r.abs().max(1.0),
+        "{ctx}: stops at α = {stop_d}, double-double at {stop_r}"
+    );
+    assert_eq!(branches_d, branches_r, "{ctx}: branches");
+}

@@ -824,6 +824,57 @@ impl Path {
                 cands = w;
             }
         }
+        // In double, a node off `nodes` whose guard is at zero only to the data's accuracy
+        // (within 4 times the usual thresholds, where the data leave the forces
+        // undetermined by more) may belong to a degenerate point whose nodes rounding has
+        // put apart. Where the nodes switching with it give two or more continuations that
+        // keep the path's orientation, the point is a bifurcation where the path stops, as
+        // it does in double-double: on a mirror-symmetric body in double (660 contact
+        // nodes, F = 5, oscillating load) a node and its image reached their cone's edge
+        // 2.1e-13 apart (3.3 times the usual threshold), where double-double finds three
+        // continuations, two keeping the orientation; the node alone was taken, and the
+        // path went on along an asymmetric branch, unflagged. Elsewhere the path is left
+        // as it was: at regular transitions of mirrored pairs the widened thresholds let
+        // through pieces that double-double does not, and two bodies had such transitions
+        // flagged as bifurcations where the path went on.
+        // (How far the data determine q costs a few solves with A, once per path: only
+        // where a guard is that near zero at 4 times the usual thresholds alone.)
+        if cands.len() == 1 && !self.problem.extended_precision() {
+            let c = self.consts();
+            let rows = self.guard_table(&cur.classes, &pt, None);
+            let tol = self.tol_at(&pt);
+            let near = |widen: Widen| -> Vec<usize> {
+                let tol = tol.clone().widened(widen);
+                rows.iter()
+                    .filter(|row| {
+                        !nodes.contains(&row.guard.node)
+                            && row.value.abs() <= tol.of(&c.guard_form(row.guard))
+                    })
+                    .map(|row| row.guard.node)
+                    .collect()
+            };
+            if !near(Widen { k: 4.0, ..usual }).is_empty()
+                && let Some(first) = self.determined(&pt)
+                && self.problem.w_condition_estimate() * first.determined / self.opts.zero_tol
+                    >= 4.0
+            {
+                let widen = Widen { k: 4.0, ..first };
+                let mut all = nodes.clone();
+                all.extend(near(widen));
+                all.sort_unstable();
+                all.dedup();
+                if let Ok(wider) =
+                    self.continuations_either(&pt, &cur.classes, &all, back, &mut blockers, widen)
+                {
+                    let wider = without_retrace(wider);
+                    let sigma = self.trace.as_ref().expect("started").sigma;
+                    if wider.iter().filter(|cd| cd.orientation == sigma).count() > 1 {
+                        cands = wider;
+                        nodes = all;
+                    }
+                }
+            }
+        }
         self.close_piece(&pt);
         let (events_start, pieces_len, last_dir, sigma) = {
             let tr = self.trace.as_ref().expect("started");
