@@ -619,7 +619,8 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
 /// before it walked backwards, and the path took it: a fold that the trace in
 /// double-double does not have (it has none in the load's two periods), then 2000 events
 /// walked back along the path's own, to a closed loop. The way the path came across
-/// pieces a rounding long is never a continuation: the path must reach the window's end
+/// pieces a rounding long is taken only where no retry of the join finds another
+/// continuation (here they switch the image too): the path must reach the window's end
 /// with no fold and no bifurcation flagged, every event mirrored (the body's symmetry:
 /// the same α to 1e-9, S+ and S− swapped), the centre node never slipping. (Over the two
 /// periods the trace in double now has the 14,432 events of double-double, α within

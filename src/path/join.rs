@@ -639,7 +639,8 @@ impl Path {
         // After pieces a rounding long (transitions a rounding apart, see below), the
         // pieces before them contain the point too, within the thresholds, and walked
         // backwards they enter their regions: that is the way the path came, neither a
-        // branch nor a continuation, and it is never taken. Mirrored nodes in double were
+        // branch, and it is taken only where no retry below finds another continuation
+        // (where it was the only piece found, it was taken at once). Mirrored nodes in double were
         // flagged as bifurcations, one and two pieces back; and where that walk back was
         // the only piece found (a symmetric body of 1002 contact nodes in double, F = 5,
         // under an oscillating load: one node of a mirrored pair lifted off alone, on a
@@ -690,9 +691,12 @@ impl Path {
             &mut blockers,
             usual,
         ) {
-            Ok(cands) => (without_retrace(cands), None),
+            Ok(cands) => (cands, None),
             Err(e) => (Vec::new(), Some(e)),
         };
+        // (kept for the last resort below)
+        let walked_back = std::mem::take(&mut cands);
+        cands = without_retrace(walked_back.clone());
         // A node that the way in found clear of zero (its guard crossing a step beyond
         // `zero_tol` along the old piece) may be at zero and leaving along every
         // neighbouring piece: it switches here too. Transitions a rounding apart look like
@@ -704,14 +708,9 @@ impl Path {
             nodes.append(&mut blockers);
             nodes.sort_unstable();
             nodes.dedup();
-            cands = without_retrace(self.continuations_either(
-                &pt,
-                &cur.classes,
-                &nodes,
-                back,
-                &mut blockers,
-                usual,
-            )?);
+            let again =
+                self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, usual)?;
+            cands = without_retrace(again);
         }
         // A single continuation at the usual thresholds that the data do not determine: a
         // switching node fits other classes where no displacement row's threshold is
@@ -874,6 +873,12 @@ impl Path {
                     }
                 }
             }
+        }
+        // Where no retry found another continuation, the way back after all: on the
+        // 2001 × 3 strip on 200 × 0.2 (F = 1, double-double) near α = −2 the path holds
+        // from the data along it (`python/tests/test_from_data.py`).
+        if cands.is_empty() {
+            cands = walked_back;
         }
         self.close_piece(&pt);
         let (events_start, pieces_len, last_dir, sigma) = {
