@@ -638,17 +638,17 @@ impl Path {
         let mut blockers = Vec::new();
         // After pieces a rounding long (transitions a rounding apart, see below), the
         // pieces before them contain the point too, within the thresholds, and walked
-        // backwards they enter their regions: that is the way the path came, neither a
-        // branch, and it is taken only where no retry below finds another continuation
-        // (where it was the only piece found, it was taken at once). Mirrored nodes in double were
-        // flagged as bifurcations, one and two pieces back; and where that walk back was
-        // the only piece found (a symmetric body of 1002 contact nodes in double, F = 5,
-        // under an oscillating load: one node of a mirrored pair lifted off alone, on a
-        // piece of length 0, its image's λν at zero by rounding), the path took it as a
-        // fold and walked its own events back for 2000 more, to a closed loop; without
-        // it, the retries below switch the image too, as double-double does. Only across
-        // such pieces: a path that comes back to a bifurcation point along pieces of some
-        // length may go on along one it walked the other way.
+        // backwards they enter their regions: that is the way the path came, not a
+        // branch, and it is taken only where no retry below finds another continuation.
+        // Mirrored nodes in double were flagged as bifurcations, one and two pieces back;
+        // and where that walk back was the only piece found, it used to be taken at once
+        // (a symmetric body of 1002 contact nodes in double, F = 5, under an oscillating
+        // load: one node of a mirrored pair lifted off alone, on a piece of length 0, its
+        // image's λν at zero by rounding; the path took the walk back as a fold and
+        // retraced 2000 events, to a closed loop), where the retries below switch the
+        // image too, as double-double does. Only across such pieces: a path that comes
+        // back to a bifurcation point along pieces of some length may go on along one it
+        // walked the other way.
         let recent: Vec<(Vec<Class>, i8)> = {
             let tiny = |a0: f64, a1: f64, l0: &[f64], l1: &[f64]| {
                 let scale = inf_norm(l0).max(inf_norm(l1));
@@ -671,13 +671,13 @@ impl Path {
             }
             out
         };
+        let retraces = |cd: &Candidate| {
+            let t_alpha = cd.t.last().copied().unwrap_or(0.0);
+            recent.iter().any(|(classes, direction)| {
+                cd.classes == *classes && t_alpha * f64::from(*direction) < 0.0
+            })
+        };
         let without_retrace = |mut cands: Vec<Candidate>| {
-            let retraces = |cd: &Candidate| {
-                let t_alpha = cd.t.last().copied().unwrap_or(0.0);
-                recent.iter().any(|(classes, direction)| {
-                    cd.classes == *classes && t_alpha * f64::from(*direction) < 0.0
-                })
-            };
             cands.retain(|cd| !retraces(cd));
             cands
         };
@@ -694,9 +694,9 @@ impl Path {
             Ok(cands) => (cands, None),
             Err(e) => (Vec::new(), Some(e)),
         };
-        // (kept for the last resort below)
-        let walked_back = std::mem::take(&mut cands);
-        cands = without_retrace(walked_back.clone());
+        // (the walk back kept for the last resort below)
+        let walked_back: Vec<Candidate>;
+        (cands, walked_back) = cands.into_iter().partition(|cd| !retraces(cd));
         // A node that the way in found clear of zero (its guard crossing a step beyond
         // `zero_tol` along the old piece) may be at zero and leaving along every
         // neighbouring piece: it switches here too. Transitions a rounding apart look like
@@ -839,6 +839,7 @@ impl Path {
         // (How far the data determine q costs a few solves with A, once per path: only
         // where a guard is that near zero at 4 times the usual thresholds alone.)
         if cands.len() == 1 && !self.problem.extended_precision() {
+            // (`c` again: the one above borrows `self` across its mutable uses since)
             let c = self.consts();
             let rows = self.guard_table(&cur.classes, &pt, None);
             let tol = self.tol_at(&pt);
@@ -852,12 +853,10 @@ impl Path {
                     .map(|row| row.guard.node)
                     .collect()
             };
+            // (the first of `widening`'s steps by a factor, where it has one)
             if !near(Widen { k: 4.0, ..usual }).is_empty()
-                && let Some(first) = self.determined(&pt)
-                && self.problem.w_condition_estimate() * first.determined / self.opts.zero_tol
-                    >= 4.0
+                && let Some(widen) = self.widening(&pt).into_iter().find(|w| w.k == 4.0)
             {
-                let widen = Widen { k: 4.0, ..first };
                 let mut all = nodes.clone();
                 all.extend(near(widen));
                 all.sort_unstable();
