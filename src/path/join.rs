@@ -847,8 +847,11 @@ impl Path {
                 let tol = tol.clone().widened(widen);
                 rows.iter()
                     .filter(|row| {
+                        let f = c.guard_form(row.guard);
+                        // (the O(1) bound first: `of` costs a pass over a row of W)
                         !nodes.contains(&row.guard.node)
-                            && row.value.abs() <= tol.of(&c.guard_form(row.guard))
+                            && row.value.abs() <= tol.upper(&f)
+                            && row.value.abs() <= tol.of(&f)
                     })
                     .map(|row| row.guard.node)
                     .collect()
@@ -1064,10 +1067,10 @@ impl Path {
             // its threshold (a node whose gap closed between the point and the snapped α
             // has its own transition there).
             let c = self.consts();
-            let inside = self
-                .guard_table(classes, &snapped, None)
-                .iter()
-                .all(|g| g.value >= -tol.of(&c.guard_form(g.guard)));
+            let inside = self.guard_table(classes, &snapped, None).iter().all(|g| {
+                let f = c.guard_form(g.guard);
+                g.value >= -tol.upper(&f) && g.value >= -tol.of(&f)
+            });
             if inside {
                 return Ok(snapped);
             }
