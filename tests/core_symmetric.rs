@@ -727,3 +727,61 @@ fn a_symmetric_bifurcation_in_double_is_not_decided_by_rounding() {
     );
     assert_eq!(branches_d, branches_r, "{ctx}: branches");
 }
+
+/// A mirror-symmetric body of 721 contact nodes in double ([`common::symmetric_fe_case`]
+/// seed 220, 720 × 2 elements, F = 0.1) under the oscillating basis load of
+/// [`oscillating_load`], α from 0 to 0.07 (about 2500 events). Two rounding artefacts,
+/// each silent, that double-double does not have:
+/// - at α = 0.00254 the node on the axis, the last in contact, lifts off; its λt is 0 by
+///   symmetry (rounding in double, 1.8e-12 of the force scale), so it reached its stick
+///   cone 1.4e-13 in α before its λν reached 0, and slipped for that long before it
+///   lifted off: a slip the symmetry excludes, and an event too many;
+/// - at α = 0.0629 a mirrored pair (nodes 16 and 706) sticking then slipping switched
+///   9.1e-13 apart in α; at the second switch the walk back along the piece before was
+///   taken for a second continuation, and the first event was flagged as a bifurcation.
+///
+/// By the symmetry every event must have its mirror image (the same α to 1e-9, S+ and S−
+/// swapped), the centre node must never slip, and no event may be flagged.
+#[test]
+fn the_last_node_lifting_off_on_the_axis_in_double_does_not_slip() {
+    let nx = 720;
+    let ctx = "seed 220 (nx = 720, ny = 2, F = 0.1, oscillating, double)";
+    let case = common::symmetric_fe_case(220, nx, 2, 0.1);
+    let problem = case
+        .data
+        .builder()
+        .extended_precision(fricont::ExtendedPrecision::Off)
+        .build()
+        .expect("problem");
+    let (load, _) = oscillating_load(&case);
+    let mut path =
+        Path::new(Arc::new(problem), load, PathOptions::window(0.0, 0.07)).expect("path");
+    path.start(0.0, None).expect("start");
+    path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
+    assert_eq!(path.end_reason(), Some(&EndReason::Window), "{ctx}");
+    if let Some(e) = path.events().iter().find(|e| e.fold || e.bifurcation) {
+        panic!(
+            "{ctx}: event {} (node {} {} -> {} at α = {:e}) flagged as a fold or bifurcation",
+            e.index,
+            e.node + 1,
+            e.from,
+            e.to,
+            e.alpha
+        );
+    }
+    let ev: Vec<(f64, usize, Class, Class)> = path
+        .events()
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect();
+    let centre_lift_offs = ev
+        .iter()
+        .filter(|&&(_, i, _, to)| 2 * i == nx && to == Class::Open)
+        .count();
+    assert!(
+        centre_lift_offs >= 1,
+        "{ctx}: the centre node never lifts off"
+    );
+    let pairs = assert_mirrored(ctx, &ev, nx);
+    assert!(pairs >= 2000, "{ctx}: {pairs} mirrored events");
+}

@@ -650,8 +650,16 @@ impl Path {
         // back to a bifurcation point along pieces of some length may go on along one it
         // walked the other way.
         let recent: Vec<(Vec<Class>, i8)> = {
+            // (the forces' change against the point's force scale, as `rounding_short`
+            // measures it: their rounding is relative to the load's terms, not to the
+            // forces, which can be far smaller. Against the forces alone, a mirrored pair
+            // in double (721 contact nodes, F = 0.1, oscillating load) that switched
+            // 9.1e-13 apart in α, its forces moving by 5e-8 of their size and 9e-10 of the
+            // force scale, took the walk back for a second continuation: the first event
+            // was flagged as a bifurcation that double-double does not have.)
+            let scale = self.force_scale(&pt);
             let tiny = |a0: f64, a1: f64, l0: &[f64], l1: &[f64]| {
-                let scale = inf_norm(l0).max(inf_norm(l1));
+                let scale = scale.max(inf_norm(l0)).max(inf_norm(l1));
                 (a1 - a0).abs() <= ROUNDING_LONG * a0.abs().max(1.0)
                     && max_abs_diff(l0, l1) <= ROUNDING_LONG * scale
             };
@@ -664,7 +672,12 @@ impl Path {
                     .rev()
                 {
                     out.push((p.classes.clone(), p.direction));
-                    if !tiny(p.alpha_from, p.alpha_to, &p.lambda_from, &p.lambda_to) {
+                    // (the stored pieces' forces in the user's units)
+                    let (l0, l1) = (
+                        self.lam_to_internal(&p.lambda_from),
+                        self.lam_to_internal(&p.lambda_to),
+                    );
+                    if !tiny(p.alpha_from, p.alpha_to, &l0, &l1) {
                         break;
                     }
                 }
@@ -727,15 +740,65 @@ impl Path {
         // below a floor of 2e-7 and would slip for 1.9e-4 in α: taking stick there lost
         // that slip (the independent reference has it), or the path stopped at the next
         // transition with the node fitting no class at the usual thresholds.
-        if cands.len() == 1
-            && self.rounding_short(&pt, &cands[0], &nodes)
-            && let Some(widen) = self.undetermined_fit(&pt, &nodes)
-            && let Ok(wider) =
-                self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, widen)
-        {
-            let wider = without_retrace(wider);
-            if wider.len() == 1 {
-                cands = wider;
+        if cands.len() == 1 && self.rounding_short(&pt, &cands[0], &nodes) {
+            let mut taken = false;
+            if let Some(widen) = self.undetermined_fit(&pt, &nodes)
+                && let Ok(wider) =
+                    self.continuations_either(&pt, &cur.classes, &nodes, back, &mut blockers, widen)
+            {
+                let wider = without_retrace(wider);
+                if wider.len() == 1 {
+                    cands = wider;
+                    taken = true;
+                }
+            }
+            // Where the forces too are at zero only to the data's accuracy (the widest
+            // thresholds fit the switching nodes to classes the usual ones do not): the
+            // first of the last-resort thresholds (`widening`) with exactly one
+            // continuation that is not itself a rounding long is taken. On a
+            // mirror-symmetric body in double (721 contact nodes, F = 0.1, oscillating
+            // load), the node on the axis, the last in contact, reached its stick cone
+            // 1.4e-13 in α before its λν reached 0 (its λt, 0 by symmetry, was 1.8e-12 of
+            // the force scale, within how far the data determine it; λν at the cone's edge
+            // is that over F): it slipped for 1.4e-13 and then lifted off, two events and a
+            // slip that double-double, and the symmetry, do not have.
+            if !taken {
+                let tol = self.tol_at(&pt);
+                let widest = Widen {
+                    k: MAX_WIDENING,
+                    cone: true,
+                    ..usual
+                };
+                let usual_fit = self.compatible(&nodes, &pt, &tol);
+                if self.compatible(&nodes, &pt, &tol.clone().widened(widest)) != usual_fit {
+                    for widen in self.widening(&pt) {
+                        let Ok(wider) = self.continuations_either(
+                            &pt,
+                            &cur.classes,
+                            &nodes,
+                            back,
+                            &mut blockers,
+                            widen,
+                        ) else {
+                            continue;
+                        };
+                        // (in extended precision, passing through the point as in the
+                        // last resort below)
+                        let widened = tol.clone().widened(widen);
+                        let lasting: Vec<Candidate> = without_retrace(wider)
+                            .into_iter()
+                            .filter(|cd| {
+                                !self.rounding_short(&pt, cd, &nodes)
+                                    && (!self.problem.extended_precision()
+                                        || self.passes_through_at(&pt, cd, &widened))
+                            })
+                            .collect();
+                        if lasting.len() == 1 {
+                            cands = lasting;
+                            break;
+                        }
+                    }
+                }
             }
         }
         // The last resort where the usual thresholds find no continuation or several, as
