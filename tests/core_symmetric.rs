@@ -630,7 +630,20 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
 fn a_mirrored_pair_lifting_off_in_double_is_not_a_fold() {
     let nx = 1001;
     let ctx = "seed 51 (nx = 1001, ny = 2, F = 5, oscillating, double)";
-    let case = common::symmetric_fe_case(51, nx, 2, 5.0);
+    let ev = unflagged_in_double(ctx, (51, nx, 2, 5.0), 0.0645);
+    let pairs = assert_mirrored(ctx, &ev, nx);
+    assert!(pairs >= 4000, "{ctx}: {pairs} mirrored events");
+}
+
+/// The body `(seed, nx, ny, F)` of [`common::symmetric_fe_case`] traced in double under
+/// [`oscillating_load`] from α = 0 to `a1`: the path must reach the window's end with no
+/// event flagged as a fold or a bifurcation. Returns its events.
+fn unflagged_in_double(
+    ctx: &str,
+    (seed, nx, ny, friction): (u64, usize, usize, f64),
+    a1: f64,
+) -> Vec<(f64, usize, Class, Class)> {
+    let case = common::symmetric_fe_case(seed, nx, ny, friction);
     let problem = case
         .data
         .builder()
@@ -638,8 +651,7 @@ fn a_mirrored_pair_lifting_off_in_double_is_not_a_fold() {
         .build()
         .expect("problem");
     let (load, _) = oscillating_load(&case);
-    let mut path =
-        Path::new(Arc::new(problem), load, PathOptions::window(0.0, 0.0645)).expect("path");
+    let mut path = Path::new(Arc::new(problem), load, PathOptions::window(0.0, a1)).expect("path");
     path.start(0.0, None).expect("start");
     path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
     assert_eq!(path.end_reason(), Some(&EndReason::Window), "{ctx}");
@@ -653,13 +665,10 @@ fn a_mirrored_pair_lifting_off_in_double_is_not_a_fold() {
             e.alpha
         );
     }
-    let ev: Vec<(f64, usize, Class, Class)> = path
-        .events()
+    path.events()
         .iter()
         .map(|e| (e.alpha, e.node, e.from, e.to))
-        .collect();
-    let pairs = assert_mirrored(ctx, &ev, nx);
-    assert!(pairs >= 4000, "{ctx}: {pairs} mirrored events");
+        .collect()
 }
 
 /// A mirror-symmetric body of 660 contact nodes ([`common::symmetric_fe_case`] seed 107,
@@ -746,34 +755,7 @@ fn a_symmetric_bifurcation_in_double_is_not_decided_by_rounding() {
 fn the_last_node_lifting_off_on_the_axis_in_double_does_not_slip() {
     let nx = 720;
     let ctx = "seed 220 (nx = 720, ny = 2, F = 0.1, oscillating, double)";
-    let case = common::symmetric_fe_case(220, nx, 2, 0.1);
-    let problem = case
-        .data
-        .builder()
-        .extended_precision(fricont::ExtendedPrecision::Off)
-        .build()
-        .expect("problem");
-    let (load, _) = oscillating_load(&case);
-    let mut path =
-        Path::new(Arc::new(problem), load, PathOptions::window(0.0, 0.07)).expect("path");
-    path.start(0.0, None).expect("start");
-    path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
-    assert_eq!(path.end_reason(), Some(&EndReason::Window), "{ctx}");
-    if let Some(e) = path.events().iter().find(|e| e.fold || e.bifurcation) {
-        panic!(
-            "{ctx}: event {} (node {} {} -> {} at α = {:e}) flagged as a fold or bifurcation",
-            e.index,
-            e.node + 1,
-            e.from,
-            e.to,
-            e.alpha
-        );
-    }
-    let ev: Vec<(f64, usize, Class, Class)> = path
-        .events()
-        .iter()
-        .map(|e| (e.alpha, e.node, e.from, e.to))
-        .collect();
+    let ev = unflagged_in_double(ctx, (220, nx, 2, 0.1), 0.07);
     let centre_lift_offs = ev
         .iter()
         .filter(|&&(_, i, _, to)| 2 * i == nx && to == Class::Open)

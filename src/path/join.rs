@@ -9,6 +9,14 @@ use crate::dense::max_abs_diff;
 /// The widest of `transit`'s last-resort thresholds, as a multiple of the usual ones.
 pub(super) const MAX_WIDENING: f64 = 64.0;
 
+/// The usual thresholds [`MAX_WIDENING`] times wider, an open node's λt against F times
+/// them ([`Widen::cone`]): what any of `transit`'s retries could let a node fit.
+const WIDEST: Widen = Widen {
+    k: MAX_WIDENING,
+    cone: true,
+    ..Widen::USUAL
+};
+
 /// The pieces before the current one that `transit` compares a candidate with (a way back
 /// along one of them, across pieces a rounding long, is not a branch).
 const RETRACE_LOOKBACK: usize = 4;
@@ -764,13 +772,8 @@ impl Path {
             // slip that double-double, and the symmetry, do not have.
             if !taken {
                 let tol = self.tol_at(&pt);
-                let widest = Widen {
-                    k: MAX_WIDENING,
-                    cone: true,
-                    ..usual
-                };
                 let usual_fit = self.compatible(&nodes, &pt, &tol);
-                if self.compatible(&nodes, &pt, &tol.clone().widened(widest)) != usual_fit {
+                if self.compatible(&nodes, &pt, &tol.clone().widened(WIDEST)) != usual_fit {
                     for widen in self.widening(&pt) {
                         let Ok(wider) = self.continuations_either(
                             &pt,
@@ -837,12 +840,7 @@ impl Path {
             // displacement of 1.5e-4 (the largest of any node) stick, the single piece
             // found so was taken, and the fold of each copy was skipped.
             let several = if cands.len() > 1 {
-                let widest = Widen {
-                    k: MAX_WIDENING,
-                    cone: true,
-                    ..usual
-                };
-                Some(self.compatible(&nodes, &pt, &self.tol_at(&pt).widened(widest)))
+                Some(self.compatible(&nodes, &pt, &self.tol_at(&pt).widened(WIDEST)))
             } else {
                 None
             };
