@@ -680,7 +680,7 @@ impl Path {
                     .rev()
                 {
                     out.push((p.classes.clone(), p.direction));
-                    // (the stored pieces' forces in the user's units)
+                    // (the stored pieces keep their forces in the user's units)
                     let (l0, l1) = (
                         self.lam_to_internal(&p.lambda_from),
                         self.lam_to_internal(&p.lambda_to),
