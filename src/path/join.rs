@@ -105,6 +105,29 @@ impl Path {
         (self.compatible(nodes, pt, &tol.widened(widen)) != usual).then_some(widen)
     }
 
+    /// The continuations at the widened thresholds `widen` (`continuations_either`) less
+    /// the way back (`retraces`); in extended precision also less those that do not pass
+    /// through the point to those thresholds (see `transit_at`'s last resort).
+    #[allow(clippy::too_many_arguments)]
+    fn widened_continuations(
+        &mut self,
+        pt: &Point,
+        fixed: &[Class],
+        nodes: &[usize],
+        back: Option<(&[Class], &[f64])>,
+        blockers: &mut Vec<usize>,
+        widen: Widen,
+        retraces: &dyn Fn(&Candidate) -> bool,
+    ) -> Result<Vec<Candidate>> {
+        let mut wider = self.continuations_either(pt, fixed, nodes, back, blockers, widen)?;
+        wider.retain(|cd| !retraces(cd));
+        if self.problem.extended_precision() {
+            let tol = self.tol_at(pt).widened(widen);
+            wider.retain(|cd| self.passes_through_at(pt, cd, &tol));
+        }
+        Ok(wider)
+    }
+
     /// Whether a guard of a node of `nodes` on candidate `cd` reaches zero within a
     /// rounding of `pt` ([`ROUNDING_LONG`] in α and in the forces): the node would switch
     /// again at once, so the candidate may be an artefact of the point's rounding.
@@ -775,27 +798,18 @@ impl Path {
                 let usual_fit = self.compatible(&nodes, &pt, &tol);
                 if self.compatible(&nodes, &pt, &tol.clone().widened(WIDEST)) != usual_fit {
                     for widen in self.widening(&pt) {
-                        let Ok(wider) = self.continuations_either(
+                        let Ok(mut lasting) = self.widened_continuations(
                             &pt,
                             &cur.classes,
                             &nodes,
                             back,
                             &mut blockers,
                             widen,
+                            &retraces,
                         ) else {
                             continue;
                         };
-                        // (in extended precision, passing through the point as in the
-                        // last resort below)
-                        let widened = tol.clone().widened(widen);
-                        let lasting: Vec<Candidate> = without_retrace(wider)
-                            .into_iter()
-                            .filter(|cd| {
-                                !self.rounding_short(&pt, cd, &nodes)
-                                    && (!self.problem.extended_precision()
-                                        || self.passes_through_at(&pt, cd, &widened))
-                            })
-                            .collect();
+                        lasting.retain(|cd| !self.rounding_short(&pt, cd, &nodes));
                         if lasting.len() == 1 {
                             cands = lasting;
                             break;
@@ -846,24 +860,21 @@ impl Path {
             };
             let mut first = None;
             for widen in self.widening(&pt) {
-                let mut wider = match self.continuations_either(
+                let mut wider = match self.widened_continuations(
                     &pt,
                     &cur.classes,
                     &nodes,
                     back,
                     &mut blockers,
                     widen,
+                    &retraces,
                 ) {
-                    Ok(wider) => without_retrace(wider),
+                    Ok(wider) => wider,
                     Err(e) => {
                         unfit.get_or_insert(e);
                         continue;
                     }
                 };
-                if self.problem.extended_precision() {
-                    let tol = self.tol_at(&pt).widened(widen);
-                    wider.retain(|cd| self.passes_through_at(&pt, cd, &tol));
-                }
                 if let Some(fits) = &several {
                     wider.retain(|cd| {
                         nodes
@@ -908,11 +919,8 @@ impl Path {
                 let tol = tol.clone().widened(widen);
                 rows.iter()
                     .filter(|row| {
-                        let f = c.guard_form(row.guard);
-                        // (the O(1) bound first: `of` costs a pass over a row of W)
                         !nodes.contains(&row.guard.node)
-                            && row.value.abs() <= tol.upper(&f)
-                            && row.value.abs() <= tol.of(&f)
+                            && tol.within(&c.guard_form(row.guard), row.value.abs())
                     })
                     .map(|row| row.guard.node)
                     .collect()
@@ -1128,10 +1136,10 @@ impl Path {
             // its threshold (a node whose gap closed between the point and the snapped α
             // has its own transition there).
             let c = self.consts();
-            let inside = self.guard_table(classes, &snapped, None).iter().all(|g| {
-                let f = c.guard_form(g.guard);
-                g.value >= -tol.upper(&f) && g.value >= -tol.of(&f)
-            });
+            let inside = self
+                .guard_table(classes, &snapped, None)
+                .iter()
+                .all(|g| tol.within(&c.guard_form(g.guard), -g.value));
             if inside {
                 return Ok(snapped);
             }

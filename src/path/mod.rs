@@ -601,6 +601,12 @@ impl Tol {
                     && a <= self.rounding * self.of(f)))
     }
 
+    /// `a ≤` [`Self::of`]`(f)`, its O(1) bound [`Self::upper`] tested first (`of` may cost
+    /// a pass over a row of W). False for a NaN `a`.
+    fn within(&self, f: &crate::piece::LinForm, a: f64) -> bool {
+        a <= self.upper(f) && a <= self.of(f)
+    }
+
     /// An upper bound of [`Self::of`] that costs O(1): a value above it is above the
     /// threshold without computing the threshold.
     fn upper(&self, f: &crate::piece::LinForm) -> f64 {
