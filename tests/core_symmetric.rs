@@ -767,3 +767,21 @@ fn the_last_node_lifting_off_on_the_axis_in_double_does_not_slip() {
     let pairs = assert_mirrored(ctx, &ev, nx);
     assert!(pairs >= 2000, "{ctx}: {pairs} mirrored events");
 }
+
+/// A mirror-symmetric body of 571 contact nodes in double ([`common::symmetric_fe_case`]
+/// seed 274, 570 × 1 elements, F = 5) under the oscillating basis load of
+/// [`oscillating_load`], α from 0 to 0.0735 (about 2300 events). At α = 0.0732688 the
+/// pair beside the node on the axis (nodes 285 and 287), sticking, slipped for 2.5e-9 in
+/// α and lifted off; their tangential displacements had moved by a third of their
+/// threshold in double, so that stick fitted the point again, and the way back along the
+/// sticking piece was taken for a second continuation: the lift-off was flagged as a
+/// bifurcation, which double-double does not have (the path went on, the events right).
+/// No event may be flagged, and every event must have its mirror image.
+#[test]
+fn a_pair_slipping_briefly_before_it_lifts_off_is_not_a_bifurcation() {
+    let nx = 570;
+    let ctx = "seed 274 (nx = 570, ny = 1, F = 5, oscillating, double)";
+    let ev = unflagged_in_double(ctx, (274, nx, 1, 5.0), 0.0735);
+    let pairs = assert_mirrored(ctx, &ev, nx);
+    assert!(pairs >= 1000, "{ctx}: {pairs} mirrored events");
+}
