@@ -695,22 +695,24 @@ impl Path {
                     && max_abs_diff(l0, l1) <= ROUNDING_LONG * scale
             };
             // The piece before the current one is walked back across the current one
-            // wherever that is a rounding long in α alone: the two pieces' solution sets
-            // meet at the current piece's start, and a point of the current one beyond it
-            // on the one before too would make them one (two lines, or, under a nonlinear
-            // load, two curves meeting twice only where the load comes back, over more
-            // than a rounding in α). So where the point fits that piece, it is to the
-            // thresholds only. On a mirror-symmetric body in double (571 contact nodes,
-            // F = 5, oscillating load) a mirrored pair, sticking, slipped for 2.5e-9 in α
-            // (its forces moving by 1e-7 of the force scale) and lifted off: the
-            // tangential displacements had moved by a third of their threshold, so that
-            // stick fitted the point again, and the way back along the sticking piece was
-            // taken for a second continuation (the event flagged as a bifurcation that
-            // double-double does not have).
+            // under an affine load always, else wherever the current piece is a rounding
+            // long in α: the two pieces' solution sets meet at the current piece's start,
+            // and a point of the current one beyond it on the one before too would make
+            // them one (two lines; under a nonlinear load, two curves, which meet twice
+            // only where the load comes back, over more than a rounding in α). So where
+            // the point fits that piece, it is to the thresholds only. In double, on a
+            // mirror-symmetric body (571 contact nodes, F = 5, oscillating load) a
+            // mirrored pair, sticking, slipped for 2.5e-9 in α (its forces moving by 1e-7
+            // of the force scale) and lifted off, its tangential displacements at a third
+            // of their threshold; on another (430 contact nodes, F = 5, affine load) a
+            // pair slipped for 1.1e-6 in α (4.8e-7 of it), its tangential displacements at
+            // a fifth of their threshold. Both times stick fitted the point again, the way
+            // back along the sticking piece was taken for a second continuation, and the
+            // lift-off was flagged as a bifurcation that double-double does not have.
             let tr = self.trace.as_ref().expect("started");
             let mut out = Vec::new();
-            let mut across =
-                (pt.alpha - cur.alpha).abs() <= ROUNDING_LONG * cur.alpha.abs().max(1.0);
+            let mut across = self.load.is_affine()
+                || (pt.alpha - cur.alpha).abs() <= ROUNDING_LONG * cur.alpha.abs().max(1.0);
             let n = tr.pieces.len().saturating_sub(1);
             for p in tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n]
                 .iter()
