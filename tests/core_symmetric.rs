@@ -772,37 +772,25 @@ fn the_last_node_lifting_off_on_the_axis_in_double_does_not_slip() {
     assert!(pairs >= 2000, "{ctx}: {pairs} mirrored events");
 }
 
-/// A mirror-symmetric body of 571 contact nodes in double ([`common::symmetric_fe_case`]
-/// seed 274, 570 × 1 elements, F = 5) under the oscillating basis load of
-/// [`oscillating_load`], α from 0 to 0.0735 (about 2300 events). At α = 0.0732688 the
-/// pair beside the node on the axis (nodes 285 and 287), sticking, slipped for 2.5e-9 in
-/// α and lifted off; their tangential displacements had moved by a third of their
-/// threshold in double, so that stick fitted the point again, and the way back along the
-/// sticking piece was taken for a second continuation: the lift-off was flagged as a
-/// bifurcation, which double-double does not have (the path went on, the events right).
-/// No event may be flagged, and every event must have its mirror image.
+/// Mirror-symmetric bodies in double ([`common::symmetric_fe_case`]) where a mirrored
+/// pair, sticking, slipped briefly and lifted off; their tangential displacements had
+/// moved by a fraction of their threshold in double, so that stick fitted the point
+/// again, and the way back along the sticking piece was taken for a second continuation:
+/// the lift-off was flagged as a bifurcation, which double-double does not have (the path
+/// went on, the events right). No event may be flagged, and every event must have its
+/// mirror image:
+/// - seed 274, 570 × 1 elements, F = 5, the oscillating basis load of
+///   [`oscillating_load`] from α = 0 to 0.0735 (about 2300 events): at α = 0.0732688 the
+///   pair beside the node on the axis slipped for 2.5e-9 in α (a third of the threshold);
+/// - seed 315, 429 × 1 elements, F = 5, its affine load over its window (about 1060
+///   events): at α = 2.2007 and 2.2059 two pairs slipped for 1.1e-6 in α (a fifth of the
+///   threshold; under an affine load two pieces' lines meet once).
 #[test]
 fn a_pair_slipping_briefly_before_it_lifts_off_is_not_a_bifurcation() {
-    let nx = 570;
-    let ctx = "seed 274 (nx = 570, ny = 1, F = 5, oscillating, double)";
-    let ev = unflagged_in_double(ctx, (274, nx, 1, 5.0), Some(0.0735));
-    let pairs = assert_mirrored(ctx, &ev, nx);
-    assert!(pairs >= 1000, "{ctx}: {pairs} mirrored events");
-}
-
-/// A mirror-symmetric body of 430 contact nodes in double ([`common::symmetric_fe_case`]
-/// seed 315, 429 × 1 elements, F = 5) under its affine load, over its window (about 1060
-/// events). At α = 2.2007 and 2.2059 a mirrored pair, sticking, slipped for 1.1e-6 in α
-/// and lifted off; their tangential displacements had moved by a fifth of their threshold
-/// in double, so that stick fitted the point again, and the way back along the sticking
-/// piece was taken for a second continuation: both lift-offs were flagged as
-/// bifurcations, which double-double does not have (under an affine load two pieces'
-/// lines meet once). No event may be flagged, and every event must have its mirror image.
-#[test]
-fn a_pair_slipping_before_it_lifts_off_under_an_affine_load_is_not_a_bifurcation() {
-    let nx = 429;
-    let ctx = "seed 315 (nx = 429, ny = 1, F = 5, affine, double)";
-    let ev = unflagged_in_double(ctx, (315, nx, 1, 5.0), None);
-    let pairs = assert_mirrored(ctx, &ev, nx);
-    assert!(pairs >= 1000, "{ctx}: {pairs} mirrored events");
+    for (seed, nx, oscillating_to) in [(274u64, 570, Some(0.0735)), (315, 429, None)] {
+        let ctx = format!("seed {seed} (nx = {nx}, ny = 1, F = 5, {oscillating_to:?}, double)");
+        let ev = unflagged_in_double(&ctx, (seed, nx, 1, 5.0), oscillating_to);
+        let pairs = assert_mirrored(&ctx, &ev, nx);
+        assert!(pairs >= 1000, "{ctx}: {pairs} mirrored events");
+    }
 }
