@@ -128,31 +128,6 @@ impl Path {
         Ok(wider)
     }
 
-    /// Whether candidate `cd`'s own point at `pt`'s α fits its classes to `tol`: in
-    /// extended precision refined from the data ([`Self::passes_through_at`]), in double
-    /// solved from the data with its updated factorisation (`xp`, one product with W for
-    /// its gaps). True where there is none (a full-pivoting solver, a vertical piece).
-    fn own_point_fits(&mut self, pt: &Point, cd: &Candidate, tol: &Tol) -> bool {
-        if self.problem.extended_precision() {
-            return self.passes_through_at(pt, cd, tol);
-        }
-        let Some(xp) = &cd.xp else {
-            return true;
-        };
-        if cd.scales.is_vertical(&cd.t) {
-            return true;
-        }
-        let at = Point {
-            lam: xp.to_vec(),
-            ..pt.clone()
-        };
-        let d = self.gaps(&at);
-        (0..cd.classes.len()).all(|i| {
-            self.compatible_at(i, &at.lam, &d, tol)
-                .contains(&cd.classes[i])
-        })
-    }
-
     /// Whether a guard of a node of `nodes` on candidate `cd` reaches zero within a
     /// rounding of `pt` ([`ROUNDING_LONG`] in α and in the forces): the node would switch
     /// again at once, so the candidate may be an artefact of the point's rounding.
@@ -705,7 +680,9 @@ impl Path {
         // image too, as double-double does. Only across such pieces: a path that comes
         // back to a bifurcation point along pieces of some length may go on along one it
         // walked the other way.
-        let recent: Vec<(Vec<Class>, i8)> = {
+        // The path's last pieces before the current one, the latest first; the walk back
+        // along the first `recent` of them is the way the path came.
+        let (last, recent): (Vec<(Vec<Class>, i8)>, usize) = {
             // (the forces' change against the point's force scale, as `rounding_short`
             // measures it: their rounding is relative to the load's terms, not to the
             // forces, which can be far smaller. Against the forces alone, a mirrored pair
@@ -735,18 +712,16 @@ impl Path {
             // back along the sticking piece was taken for a second continuation, and the
             // lift-off was flagged as a bifurcation that double-double does not have.
             let tr = self.trace.as_ref().expect("started");
-            let mut out = Vec::new();
+            let n = tr.pieces.len().saturating_sub(1);
+            let pieces = &tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n];
+            let mut recent = 0;
             let mut across = self.load.is_affine()
                 || (pt.alpha - cur.alpha).abs() <= ROUNDING_LONG * cur.alpha.abs().max(1.0);
-            let n = tr.pieces.len().saturating_sub(1);
-            for p in tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n]
-                .iter()
-                .rev()
-            {
+            for p in pieces.iter().rev() {
                 if !across {
                     break;
                 }
-                out.push((p.classes.clone(), p.direction));
+                recent += 1;
                 // (the stored pieces keep their forces in the user's units)
                 let (l0, l1) = (
                     self.lam_to_internal(&p.lambda_from),
@@ -754,14 +729,21 @@ impl Path {
                 );
                 across = tiny(p.alpha_from, p.alpha_to, &l0, &l1);
             }
-            out
+            let last = pieces
+                .iter()
+                .rev()
+                .map(|p| (p.classes.clone(), p.direction))
+                .collect();
+            (last, recent)
         };
-        let retraces = |cd: &Candidate| {
+        // (whether `cd` walks back along one of `pieces`)
+        let walks_back = |cd: &Candidate, pieces: &[(Vec<Class>, i8)]| {
             let t_alpha = cd.t.last().copied().unwrap_or(0.0);
-            recent.iter().any(|(classes, direction)| {
+            pieces.iter().any(|(classes, direction)| {
                 cd.classes == *classes && t_alpha * f64::from(*direction) < 0.0
             })
         };
+        let retraces = |cd: &Candidate| walks_back(cd, &last[..recent]);
         let without_retrace = |mut cands: Vec<Candidate>| {
             cands.retain(|cd| !retraces(cd));
             cands
@@ -794,28 +776,12 @@ impl Path {
         // a second continuation, the lift-off flagged as a bifurcation (8 in two periods)
         // that double-double does not have.
         if cands.len() > 1 {
-            let last: Vec<(Vec<Class>, i8)> = {
-                let tr = self.trace.as_ref().expect("started");
-                let n = tr.pieces.len().saturating_sub(1);
-                tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n]
-                    .iter()
-                    .map(|p| (p.classes.clone(), p.direction))
-                    .collect()
-            };
             let widest = self.tol_at(&pt).widened(WIDEST);
-            let mut k = 0;
-            while k < cands.len() {
-                let t_alpha = cands[k].t.last().copied().unwrap_or(0.0);
-                let back = last.iter().any(|(classes, direction)| {
-                    cands[k].classes == *classes && t_alpha * f64::from(*direction) < 0.0
-                });
-                let cd = cands[k].clone();
-                if back && !self.own_point_fits(&pt, &cd, &widest) {
-                    walked_back.push(cands.remove(k));
-                } else {
-                    k += 1;
-                }
-            }
+            let off: Vec<Candidate>;
+            (cands, off) = std::mem::take(&mut cands)
+                .into_iter()
+                .partition(|cd| !walks_back(cd, &last) || self.passes_through_at(&pt, cd, &widest));
+            walked_back.extend(off);
         }
         // A node that the way in found clear of zero (its guard crossing a step beyond
         // `zero_tol` along the old piece) may be at zero and leaving along every

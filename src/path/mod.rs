@@ -2021,20 +2021,37 @@ impl Path {
 
     /// Whether candidate `cand`'s piece passes through the start point `pt` in
     /// double-double: its point at `pt`'s α refined from `pt` still has every node in its
-    /// class (to the point's thresholds). True where there is no refinement (double
-    /// precision, a vertical piece, a refinement that fails): [`Self::begin`] then keeps
-    /// `pt` itself.
+    /// class (to the point's thresholds). True where there is no refinement (a vertical
+    /// piece, a refinement that fails): [`Self::begin`] then keeps `pt` itself. (In double,
+    /// [`Self::passes_through_at`]'s point solved from the data; the start asks in extended
+    /// precision only.)
     fn passes_through(&mut self, pt: &Point, cand: &Candidate) -> bool {
         let tol = self.tol_at(pt);
         self.passes_through_at(pt, cand, &tol)
     }
 
-    /// [`Self::passes_through`] to the thresholds `tol`.
+    /// Whether candidate `cand`'s own point at `pt`'s α fits its classes to `tol`: in
+    /// extended precision refined from `pt` in double-double ([`Self::passes_through`]); in
+    /// double solved from the data with its updated factorisation (`xp`, one product with
+    /// W for its gaps). True where there is none (a full-pivoting solver in double, a
+    /// vertical piece, a refinement that fails).
     fn passes_through_at(&mut self, pt: &Point, cand: &Candidate, tol: &Tol) -> bool {
         if cand.scales.is_vertical(&cand.t) {
             return true;
         }
-        let Some((lam, d)) = self.polish_point(&cand.classes, &cand.lu, pt.alpha, &pt.lam) else {
+        let own = if self.problem.extended_precision() {
+            self.polish_point(&cand.classes, &cand.lu, pt.alpha, &pt.lam)
+        } else {
+            cand.xp.as_ref().map(|xp| {
+                let at = Point {
+                    lam: xp.to_vec(),
+                    ..pt.clone()
+                };
+                let d = self.gaps(&at).to_vec();
+                (at.lam, d)
+            })
+        };
+        let Some((lam, d)) = own else {
             return true;
         };
         (0..cand.classes.len()).all(|i| {
