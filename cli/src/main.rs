@@ -9,7 +9,8 @@
 //! the path, prints the transition table (α with 14 significant digits, 1-based nodes) and
 //! the set-up/trace times, and writes the JSON report of `docs/json-report.md`. While it
 //! works it shows its progress on stderr (the phase, then α's position in the window,
-//! the transition points so far and the elapsed time, a few updates a second) when
+//! the transition points so far and the elapsed time, a few updates a second; then the
+//! JSON report's phase, whose residuals take a back-solve per transition point) when
 //! stderr is a terminal or `--progress` is given.
 //!
 //! Exit status: 0 when the path was traced (whatever its end reason except `failed`);
@@ -484,6 +485,12 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
 
     print!("{}", report::table(&mut path, Some(timing)));
     if let Some(out) = json {
+        // Each transition point's residual is a back-solve with A's factor: on large
+        // meshes with thousands of events this takes a while after the table.
+        progress.phase(&format!(
+            "writing the JSON report (the residual of {})",
+            report::plural(path.events().len(), "event")
+        ));
         let text = report::PathReport::from_path(&mut path, timing).to_json_string();
         out.write(&text)?;
     }
