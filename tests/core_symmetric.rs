@@ -772,13 +772,13 @@ fn the_last_node_lifting_off_on_the_axis_in_double_does_not_slip() {
     assert!(pairs >= 2000, "{ctx}: {pairs} mirrored events");
 }
 
-/// Mirror-symmetric bodies in double ([`common::symmetric_fe_case`], one row of
-/// elements) where a mirrored pair, sticking, slipped briefly and lifted off; their tangential displacements had
-/// moved by a fraction of their threshold in double, so that stick fitted the point
-/// again, and the way back along the sticking piece was taken for a second continuation:
-/// the lift-off was flagged as a bifurcation, which double-double does not have (the path
-/// went on, the events right). No event may be flagged, and every event must have its
-/// mirror image:
+/// Mirror-symmetric bodies in double ([`common::symmetric_fe_case`], one row of elements)
+/// where a mirrored pair, sticking, slipped briefly and lifted off; their tangential
+/// displacements had moved by a fraction of their threshold in double, so that stick fitted
+/// the point again, and the way back along the sticking piece was taken for a second
+/// continuation: the lift-off was flagged as a bifurcation, which double-double does not
+/// have (the path went on, the events right). No event may be flagged, and every event must
+/// have its mirror image:
 /// - seed 274, 570 × 1 elements, F = 5, the oscillating basis load of
 ///   [`oscillating_load`] from α = 0 to 0.0735 (about 2300 events): at α = 0.0732688 the
 ///   pair beside the node on the axis slipped for 2.5e-9 in α (a third of the threshold);
