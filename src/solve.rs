@@ -488,7 +488,7 @@ pub(crate) fn solve_fixed_alpha(
     alpha: f64,
     polish: Polish<'_>,
 ) -> Result<Vec<f64>> {
-    solve_with_frozen(problem, qg, guess, alpha, None, None, polish)
+    solve_with_frozen(problem, qg, guess, alpha, None, None, polish).map(|(lam, _)| lam)
 }
 
 /// See [`solve_fixed_alpha`]: a last chance for a stalled iterate.
@@ -497,6 +497,8 @@ pub(crate) type Polish<'a> = Option<&'a mut dyn FnMut(&[f64]) -> Option<Vec<f64>
 /// As [`solve_fixed_alpha`], with the classes of some nodes imposed, and the piece solves
 /// by updates of `seed` where given (a factorisation of a nearby piece: the path's, for
 /// the directional problem at a vertex, so that it costs O(m²) per piece, not O(m³)).
+/// Also returns the factorisation of the last piece it solved, where any (a seed for the
+/// next solve nearby, see [`newton_near`]).
 pub(crate) fn solve_with_frozen(
     problem: &crate::problem::Problem,
     qg: &[f64],
@@ -504,17 +506,50 @@ pub(crate) fn solve_with_frozen(
     alpha: f64,
     fr: Frozen<'_>,
     seed: Option<UpdatedLu>,
+    polish: Polish<'_>,
+) -> Result<(Vec<f64>, Option<UpdatedLu>)> {
+    let c = PieceConstants::of(problem);
+    let w_row_sums = problem.w_row_sums();
+    let mut pieces = PieceSolves::new(&c, problem.delassus().w(), w_row_sums, seed);
+    let lam = solve_stages(&mut pieces, w_row_sums, qg, guess, alpha, fr, polish)?;
+    Ok((lam, pieces.lu))
+}
+
+/// Damped Newton alone from `guess`, its piece solves by updates of `seed`: for a problem
+/// next to one just solved, whose solution and last factorisation ([`solve_with_frozen`])
+/// are `guess` and `seed`. The solution and the factorisation of the last piece it
+/// solved; None where Newton does not converge within `max_iter` iterations (the caller
+/// then solves from scratch).
+pub(crate) fn newton_near(
+    problem: &crate::problem::Problem,
+    qg: &[f64],
+    guess: Vec<f64>,
+    fr: Frozen<'_>,
+    seed: Option<UpdatedLu>,
+    max_iter: usize,
+) -> Option<(Vec<f64>, Option<UpdatedLu>)> {
+    let c = PieceConstants::of(problem);
+    let mut pieces = PieceSolves::new(&c, problem.delassus().w(), problem.w_row_sums(), seed);
+    let (lam, ok, _) = newton(&mut pieces, qg, guess, max_iter, fr);
+    ok.then_some((lam, pieces.lu))
+}
+
+/// The stages of [`solve_with_frozen`] on `pieces`.
+fn solve_stages(
+    pieces: &mut PieceSolves<'_>,
+    w_row_sums: &[f64],
+    qg: &[f64],
+    guess: Option<&[f64]>,
+    alpha: f64,
+    fr: Frozen<'_>,
     mut polish: Polish<'_>,
 ) -> Result<Vec<f64>> {
-    let c = PieceConstants::of(problem);
-    let w = problem.delassus().w();
+    let (c, w) = (pieces.c, pieces.w);
     let m = 2 * c.p;
-    let w_row_sums = problem.w_row_sums();
-    let mut pieces = PieceSolves::new(&c, w, w_row_sums, seed);
     let lam0 = guess.map(|g| g.to_vec()).unwrap_or_else(|| vec![0.0; m]);
     let mut notes = Vec::new();
     let mut polished = |lam: &[f64]| polish.as_mut().and_then(|f| f(lam));
-    let lam = match newton_active_newton(&mut pieces, qg, lam0, [20, 100, 200], fr) {
+    let lam = match newton_active_newton(pieces, qg, lam0, [20, 100, 200], fr) {
         Ok(lam) => return Ok(lam),
         Err((lam, msgs)) => {
             notes.extend(msgs);
@@ -529,8 +564,8 @@ pub(crate) fn solve_with_frozen(
     // Rounds of both before the long Gauss-Seidel run below (each sweep is O(m²)).
     let mut lam = lam;
     for round in 0..20 {
-        let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20, fr);
-        let (l, ok, msg) = newton(&mut pieces, qg, lam_gs, 50, fr);
+        let lam_gs = block_gauss_seidel(c, w, qg, lam, 20, fr);
+        let (l, ok, msg) = newton(pieces, qg, lam_gs, 50, fr);
         if ok {
             return Ok(l);
         }
@@ -547,12 +582,12 @@ pub(crate) fn solve_with_frozen(
     // the active set cycled on the free end's node (slip ↔ open) in every round; the
     // continuation solved it in 2.1 s, where the 20,000 sweeps took 35–55 s before
     // Newton converged (to the same solution: the path from it had the same events).
-    match friction_continuation(&c, w, w_row_sums, qg, fr) {
+    match friction_continuation(c, w, w_row_sums, qg, fr) {
         Ok(lam) => return Ok(lam),
         Err(msg) => notes.push(msg),
     }
-    let lam_gs = block_gauss_seidel(&c, w, qg, lam, 20_000, fr);
-    let (lam, ok, msg) = newton(&mut pieces, qg, lam_gs, 200, fr);
+    let lam_gs = block_gauss_seidel(c, w, qg, lam, 20_000, fr);
+    let (lam, ok, msg) = newton(pieces, qg, lam_gs, 200, fr);
     if ok {
         return Ok(lam);
     }
@@ -561,8 +596,8 @@ pub(crate) fn solve_with_frozen(
     }
     notes.push(format!("after block Gauss-Seidel: {msg}"));
     // The same from zero forces and from a uniform-stick start.
-    for start in [vec![0.0; m], stick_start(&c, w, qg)] {
-        let (lam, ok, msg) = newton(&mut pieces, qg, start, 200, fr);
+    for start in [vec![0.0; m], stick_start(c, w, qg)] {
+        let (lam, ok, msg) = newton(pieces, qg, start, 200, fr);
         if ok {
             return Ok(lam);
         }

@@ -502,45 +502,50 @@ fn identical_decoupled_nodes_slip_together() {
     slip_together(&path, root, 1e-13, "general load");
 }
 
-/// The nodes of [`identical_decoupled_nodes_slip_together`] (20, reaching `λt = F λν` at
-/// α = 1/2) and three more that touch down at that α with no tangential displacement (a
-/// zero-force vertex: `q_ν = (α − 1/2)/2`, `q_t = (α − 1/2)/10`). By hand: the twenty slip
-/// in +t after it, the three stick (`λ = −2q`: `λν = 1/2 − α`, `|λt| = |λν|/5 < F |λν|`).
-/// The vertex nodes take their classes from the directional problem at each step of the
-/// pivot on the others.
+/// The nodes of [`identical_decoupled_nodes_slip_together`] (8 or 20, reaching
+/// `λt = F λν` at α = 1/2) and three more that touch down at that α with no tangential
+/// displacement (a zero-force vertex: `q_ν = (α − 1/2)/2`, `q_t = (α − 1/2)/10`). By hand:
+/// the first slip in +t after it, the three stick (`λ = −2q`: `λν = 1/2 − α`,
+/// `|λt| = |λν|/5 < F |λν|`). The vertex nodes take their classes from the directional
+/// problem at each step of the pivot on the others (2^20 combinations of their classes are
+/// beyond any enumeration; 2^8 = 256 are beyond the 64 enumerated with directional solves,
+/// each solve started from the last one's solution).
 #[test]
 fn identical_nodes_slip_while_others_touch_down() {
-    let (pa, p) = (20, 23);
-    let problem = decoupled_nodes(p);
-    let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
-    q0[..pa].fill(0.5);
-    q1[p..p + pa].fill(0.5);
-    q0[pa..p].fill(-0.25);
-    q1[pa..p].fill(0.5);
-    q0[p + pa..].fill(-0.05);
-    q1[p + pa..].fill(0.1);
-    let mut path = run(&problem, Load::affine(q0, q1).unwrap(), 0.0, 2.0, false);
-    assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window));
-    assert_eq!(path.events().len(), p, "one event per node");
-    for e in path.events() {
-        assert!((e.alpha - 0.5).abs() <= 1e-15, "event at α = {}", e.alpha);
-        let want = if e.node < pa {
-            (fricont::Class::Stick, fricont::Class::SlipPlus)
-        } else {
-            (fricont::Class::Open, fricont::Class::Stick)
-        };
-        assert_eq!((e.from, e.to), want, "node {}", e.node);
-    }
-    let sols = path.solutions_at(1.0).expect("solutions_at");
-    assert_eq!(sols.len(), 1);
-    let st = &sols[0].state;
-    for i in 0..p {
-        let want = if i < pa { (-1.0, -0.5) } else { (-0.5, -0.1) };
-        assert!(
-            (st.lambda_n[i] - want.0).abs() <= 1e-15 && (st.lambda_t[i] - want.1).abs() <= 1e-15,
-            "node {i}: λ = ({}, {})",
-            st.lambda_n[i],
-            st.lambda_t[i]
-        );
+    for pa in [8, 20] {
+        let p = pa + 3;
+        let problem = decoupled_nodes(p);
+        let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
+        q0[..pa].fill(0.5);
+        q1[p..p + pa].fill(0.5);
+        q0[pa..p].fill(-0.25);
+        q1[pa..p].fill(0.5);
+        q0[p + pa..].fill(-0.05);
+        q1[p + pa..].fill(0.1);
+        let mut path = run(&problem, Load::affine(q0, q1).unwrap(), 0.0, 2.0, false);
+        assert_eq!(path.end_reason(), Some(&fricont::EndReason::Window), "{pa}");
+        assert_eq!(path.events().len(), p, "one event per node ({pa})");
+        for e in path.events() {
+            assert!((e.alpha - 0.5).abs() <= 1e-15, "event at α = {}", e.alpha);
+            let want = if e.node < pa {
+                (fricont::Class::Stick, fricont::Class::SlipPlus)
+            } else {
+                (fricont::Class::Open, fricont::Class::Stick)
+            };
+            assert_eq!((e.from, e.to), want, "node {} ({pa})", e.node);
+        }
+        let sols = path.solutions_at(1.0).expect("solutions_at");
+        assert_eq!(sols.len(), 1);
+        let st = &sols[0].state;
+        for i in 0..p {
+            let want = if i < pa { (-1.0, -0.5) } else { (-0.5, -0.1) };
+            assert!(
+                (st.lambda_n[i] - want.0).abs() <= 1e-15
+                    && (st.lambda_t[i] - want.1).abs() <= 1e-15,
+                "node {i} ({pa}): λ = ({}, {})",
+                st.lambda_n[i],
+                st.lambda_t[i]
+            );
+        }
     }
 }

@@ -35,6 +35,22 @@ const DETERMINATION_BOUND: f64 = 1e-8;
 /// the entry's; 5 of 28 such strips with p = 125 to 390 stopped with "fits no class".)
 const NEAR_VANISHING: f64 = 1e-6;
 
+/// Newton iterations of a directional problem from the point's last directional solution
+/// (see [`Path::directional_classes`]) before it is solved from zero forces.
+const NEAR_NEWTON_ITERATIONS: usize = 20;
+
+/// A directional solution of the current point (see `Path::directional_warm`).
+pub(super) struct DirectionalWarm {
+    /// The way along α (±1).
+    s: f64,
+    /// The point's `q'`.
+    dq: Vec<f64>,
+    /// The solution `λ̇`.
+    lam: Vec<f64>,
+    /// The factorisation of its piece, where the solver kept one.
+    lu: Option<UpdatedLu>,
+}
+
 impl Path {
     /// No displacement row's threshold below twice how far the data determine q's rows
     /// ([`crate::load::BoundLoad::determination`], in force units), nor that floor above
@@ -345,32 +361,38 @@ impl Path {
         let combos = enumerated
             .iter()
             .fold(1usize, |acc, &k| acc.saturating_mul(options[k].len()));
-        if combos > MAX_CANDIDATE_PIECES {
-            // Many nodes at a boundary between two classes at once (identical nodes
-            // reaching their friction limit together): a continuation per way along α by
-            // pivoting on their classes (those at the vertex from the directional problem).
-            let pivoting = enumerated.iter().all(|&k| options[k].len() <= 2);
-            if pivoting {
-                let mut out = Vec::new();
-                for want in [1.0, -1.0] {
-                    let Some(cl) = self.pivoted_classes(
-                        pt,
-                        fixed,
-                        (nodes, &options, &is_vertex),
-                        (want, relaxed),
-                        &tol,
-                    ) else {
-                        continue;
-                    };
-                    self.push_candidates(
-                        &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
-                    );
-                }
-                // (none: the relaxed slopes of `continuations_either` may find one)
-                if !out.is_empty() || !relaxed {
-                    return Ok(out);
-                }
+        let limit = if use_directional {
+            MAX_DIRECTIONAL_COMBINATIONS
+        } else {
+            MAX_CANDIDATE_PIECES
+        };
+        // Many nodes at a boundary between two classes at once (identical nodes reaching
+        // their friction limit together): a continuation per way along α by pivoting on
+        // their classes (those at the vertex from the directional problem).
+        let pivoting = enumerated.iter().all(|&k| options[k].len() <= 2);
+        if combos > limit && pivoting {
+            let mut out = Vec::new();
+            for want in [1.0, -1.0] {
+                let Some(cl) = self.pivoted_classes(
+                    pt,
+                    fixed,
+                    (nodes, &options, &is_vertex),
+                    (want, relaxed),
+                    &tol,
+                ) else {
+                    continue;
+                };
+                self.push_candidates(
+                    &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
+                );
             }
+            // (none: the relaxed slopes of `continuations_either` may find one; or the
+            // enumeration below, where the combinations are few enough for it)
+            if !out.is_empty() || (!relaxed && combos > MAX_CANDIDATE_PIECES) {
+                return Ok(out);
+            }
+        }
+        if combos > MAX_CANDIDATE_PIECES {
             return Err(Error::Numerical(format!(
                 "{} nodes are at a class boundary at once at alpha = {:e}: {combos} neighbouring pieces exceed the limit of {MAX_CANDIDATE_PIECES}{}",
                 enumerated.len(),
@@ -542,17 +564,52 @@ impl Path {
         s: f64,
     ) -> Option<Vec<Class>> {
         let qdir: Vec<f64> = pt.dq.iter().map(|v| s * v).collect();
-        let seed = self.updater.borrow().clone();
-        let lam = solve_with_frozen(
-            &self.problem,
-            &qdir,
-            None,
-            pt.alpha,
-            Some(frozen),
-            seed,
-            None,
-        )
-        .ok()?;
+        // From the last solution of this point's problem along this way (for other
+        // classes of the frozen nodes, which most combinations and pivoting steps change
+        // for a few nodes only), by Newton alone: on a slender strip in double (458 × 3,
+        // F = 5, κ(W) 5e9) about 140 nodes were at the vertex at once within the widened
+        // thresholds, and each of the 64 solves of a point from zero forces took about 9
+        // fresh factorisations (Newton stalled; the active-set iteration solved it).
+        // Where that does not converge, from zero forces and the path's factorisation,
+        // as ever.
+        let near = {
+            let warm = self.directional_warm.borrow();
+            warm.iter()
+                .find(|w| w.s == s && w.dq == pt.dq)
+                .map(|w| (w.lam.clone(), w.lu.clone()))
+        };
+        let (lam, lu) = match near.and_then(|(lam, lu)| {
+            newton_near(
+                &self.problem,
+                &qdir,
+                lam,
+                Some(frozen),
+                lu,
+                NEAR_NEWTON_ITERATIONS,
+            )
+        }) {
+            Some(solved) => solved,
+            None => solve_with_frozen(
+                &self.problem,
+                &qdir,
+                None,
+                pt.alpha,
+                Some(frozen),
+                self.updater.borrow().clone(),
+                None,
+            )
+            .ok()?,
+        };
+        {
+            let mut warm = self.directional_warm.borrow_mut();
+            warm.retain(|w| !(w.s == s && w.dq == pt.dq));
+            warm.push(DirectionalWarm {
+                s,
+                dq: pt.dq.clone(),
+                lam: lam.clone(),
+                lu,
+            });
+        }
         let w = self.problem.delassus().w();
         let d = displacement_gaps(w, &qdir, &lam);
         let r0 = self.problem.default_r();
@@ -584,10 +641,12 @@ impl Path {
     ) -> Result<StepOutcome> {
         let out = self.transit_at(cur, pt, crossing);
         self.resolved.borrow_mut().clear();
+        self.directional_warm.borrow_mut().clear();
         out
     }
 
-    /// [`Self::transit`], which clears the point's resolved guards after it.
+    /// [`Self::transit`], which clears the point's resolved guards and directional
+    /// solutions after it.
     fn transit_at(
         &mut self,
         cur: CurrentPiece,
