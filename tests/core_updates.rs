@@ -549,3 +549,116 @@ fn identical_nodes_slip_while_others_touch_down() {
         }
     }
 }
+
+/// A coupled condensed problem (W random SPD) where at α = 0 six to eleven nodes reach the
+/// zero-force vertex (sticking before, `λ = α y` with `yν > 0`), three to eight others reach
+/// their friction cone's edge (as in [`many_nodes_reach_their_friction_limit_together`])
+/// and the rest stick inside their cones: more than 4096 neighbouring pieces, so the
+/// vertex nodes take their classes from the directional problem, for each of the 8 to 256
+/// combinations of the others' classes (64 at most enumerated, each solve started from
+/// the last one's solution; beyond, pivoting). Checked against the fixed-α solver started
+/// afresh at half the way to the next event: the same classes and λ (1e-10 of the
+/// forces), in double and in double-double.
+#[test]
+fn vertex_nodes_beside_nodes_at_their_friction_limit() {
+    use fricont::problem::ProblemBuilder;
+    for seed in 0..12u64 {
+        let mut rng = common::Rng::new(9000 + seed);
+        let nv = 6 + rng.int(0, 5);
+        let ns = 3 + rng.int(0, 5);
+        let p = nv + ns + rng.int(0, 20);
+        let m = 2 * p;
+        let friction = [0.1, 0.3, 0.6, 1.0, 3.0][rng.int(0, 4)];
+        let coupling = rng.range(0.5, 4.0);
+        let g = nalgebra::DMatrix::<f64>::from_fn(m, m, |_, _| rng.range(-1.0, 1.0));
+        let d = nalgebra::DVector::<f64>::from_fn(m, |_, _| rng.range(1.0, 2.0));
+        let w = nalgebra::DMatrix::from_diagonal(&d) + &g * g.transpose() * (coupling / m as f64);
+        let w = (&w + w.transpose()) * 0.5;
+        // On the all-stick piece d = 0 and λ(α) = λ* + α y, for q(α) = −W (λ* + α y).
+        let (mut lam0, mut y) = (vec![0.0; m], vec![0.0; m]);
+        for i in 0..p {
+            if i < nv {
+                // at the vertex at α = 0, inside the cone before
+                y[i] = rng.range(0.5, 1.5);
+                y[p + i] = rng.range(-1.0, 1.0) * friction * y[i];
+            } else if i < nv + ns {
+                // at the cone's edge at α = 0, inside before
+                let (a, sigma) = (
+                    rng.range(1.0, 2.0),
+                    if rng.uniform() < 0.5 { 1.0 } else { -1.0 },
+                );
+                lam0[i] = -a;
+                lam0[p + i] = sigma * friction * a;
+                y[i] = rng.range(-0.1, 0.1);
+                y[p + i] = sigma * (friction * y[i].abs() + 10f64.powf(rng.range(-3.0, 0.0)));
+            } else {
+                let a = rng.range(1.0, 2.0);
+                lam0[i] = -a;
+                lam0[p + i] = rng.range(-0.5, 0.5) * friction * a;
+                y[i] = rng.range(-0.1, 0.1);
+                y[p + i] = rng.range(-0.1, 0.1) * friction;
+            }
+        }
+        let wl = |v: &[f64]| -> Vec<f64> {
+            let x = &w * nalgebra::DVector::from_column_slice(v);
+            x.iter().map(|v| -v).collect()
+        };
+        let load = || Load::affine(wl(&lam0), wl(&y)).unwrap();
+        let wf = faer::Mat::<f64>::from_fn(m, m, |i, j| w[(i, j)]);
+        for mode in [
+            fricont::ExtendedPrecision::Off,
+            fricont::ExtendedPrecision::On,
+        ] {
+            let problem = Arc::new(
+                ProblemBuilder::condensed(wf.clone())
+                    .extended_precision(mode)
+                    .friction_uniform(friction)
+                    .build()
+                    .expect("problem"),
+            );
+            let ctx = format!(
+                "seed {seed} (p = {p}, {nv} at the vertex, {ns} at the edge, F = {friction}, {mode:?})"
+            );
+            // From before α = 0, where every node sticks inside its cone.
+            let a0 = -0.2 * friction.min(1.0);
+            let mut path = run(&problem, load(), a0, 1.0, false);
+            assert_eq!(
+                path.end_reason(),
+                Some(&fricont::EndReason::Window),
+                "{ctx}: end"
+            );
+            let at_zero = path.events().iter().filter(|e| e.alpha.abs() < 1e-12);
+            assert!(
+                at_zero.count() >= nv,
+                "{ctx}: the vertex nodes' events at α = 0"
+            );
+            let next = path
+                .events()
+                .iter()
+                .map(|e| e.alpha)
+                .find(|&a| a > 1e-12)
+                .unwrap_or(1.0);
+            let at = 0.5 * next;
+            let sols = path.solutions_at(at).expect("solutions_at");
+            assert_eq!(sols.len(), 1, "{ctx}: one solution at {at}");
+            let mut fresh =
+                Path::new(problem.clone(), load(), PathOptions::window(at, 1.0)).unwrap();
+            fresh.start(at, None).expect("fresh start");
+            let want = fresh.start_state().expect("start state");
+            assert_eq!(
+                sols[0].state.classes, want.classes,
+                "{ctx}: classes at {at}"
+            );
+            let scale = want.lambda_n.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for (a, b) in sols[0]
+                .state
+                .lambda_n
+                .iter()
+                .chain(&sols[0].state.lambda_t)
+                .zip(want.lambda_n.iter().chain(&want.lambda_t))
+            {
+                assert!((a - b).abs() <= 1e-10 * scale, "{ctx}: λ {a} vs {b}");
+            }
+        }
+    }
+}
