@@ -220,6 +220,53 @@ fn directional_problem_at_a_vertex_of_many_nodes() {
     );
 }
 
+/// `W = D + c G Gᵀ / m` (D diagonal in [1, 2], G uniform in [−1, 1], both from `rng`):
+/// SPD, every node coupled to every other (entries about `c/√m` of the diagonal).
+fn coupled_w(rng: &mut common::Rng, m: usize, c: f64) -> nalgebra::DMatrix<f64> {
+    let g = nalgebra::DMatrix::<f64>::from_fn(m, m, |_, _| rng.range(-1.0, 1.0));
+    let d = nalgebra::DVector::<f64>::from_fn(m, |_, _| rng.range(1.0, 2.0));
+    let w = nalgebra::DMatrix::from_diagonal(&d) + &g * g.transpose() * (c / m as f64);
+    (&w + w.transpose()) * 0.5
+}
+
+/// Checks `path` (from before α = 0 through it) halfway to its first event after α = 0
+/// against the fixed-α solver started afresh there: one solution, with the same classes
+/// and λ (to 1e-10 of the forces). Returns the fresh solver's state.
+fn fresh_after_zero(
+    path: &mut Path,
+    problem: &Arc<Problem>,
+    load: impl Fn() -> Load,
+    ctx: &str,
+) -> fricont::path::State {
+    let next = path
+        .events()
+        .iter()
+        .map(|e| e.alpha)
+        .find(|&a| a > 1e-12)
+        .unwrap_or(1.0);
+    let at = 0.5 * next;
+    let sols = path.solutions_at(at).expect("solutions_at");
+    assert_eq!(sols.len(), 1, "{ctx}: one solution at {at}");
+    let mut fresh = Path::new(problem.clone(), load(), PathOptions::window(at, 1.0)).unwrap();
+    fresh.start(at, None).expect("fresh start");
+    let want = fresh.start_state().expect("start state");
+    assert_eq!(
+        sols[0].state.classes, want.classes,
+        "{ctx}: classes at {at}"
+    );
+    let scale = want.lambda_n.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for (a, b) in sols[0]
+        .state
+        .lambda_n
+        .iter()
+        .chain(&sols[0].state.lambda_t)
+        .zip(want.lambda_n.iter().chain(&want.lambda_t))
+    {
+        assert!((a - b).abs() <= 1e-10 * scale, "{ctx}: λ {a} vs {b}");
+    }
+    want
+}
+
 /// A condensed problem whose `p` nodes (13 to 40: 2^p > 4096 neighbouring pieces) all
 /// reach their friction cone's edge at α = 0 together: on the all-stick piece `d = 0`, so
 /// `λ(α) = −W⁻¹ q(α)` whatever W, and `q(α) = −W (λ* + α y)` puts λ on the all-stick
@@ -240,10 +287,7 @@ fn many_nodes_reach_their_friction_limit_together() {
         let friction = rng.range(0.05, 0.6);
         // W = D + G Gᵀ / m: SPD, every node coupled to every other (entries about
         // 1/√m of the diagonal), near enough to diagonal for one solution at each α.
-        let g = nalgebra::DMatrix::<f64>::from_fn(m, m, |_, _| rng.range(-1.0, 1.0));
-        let d = nalgebra::DVector::<f64>::from_fn(m, |_, _| rng.range(1.0, 2.0));
-        let w = nalgebra::DMatrix::from_diagonal(&d) + &g * g.transpose() * (2.0 / m as f64);
-        let w = (&w + w.transpose()) * 0.5;
+        let w = coupled_w(&mut rng, m, 2.0);
         let (mut lam0, mut y) = (vec![0.0; m], vec![0.0; m]);
         for i in 0..p {
             let (a, sigma) = (
@@ -296,32 +340,7 @@ fn many_nodes_reach_their_friction_limit_together() {
             path.events().iter().all(|e| e.alpha > -1e-12),
             "{ctx}: an event before α = 0"
         );
-        let next = path
-            .events()
-            .iter()
-            .map(|e| e.alpha)
-            .find(|&a| a > 1e-12)
-            .unwrap_or(1.0);
-        let at = 0.5 * next;
-        let sols = path.solutions_at(at).expect("solutions_at");
-        assert_eq!(sols.len(), 1, "{ctx}: one solution at {at}");
-        let mut fresh = Path::new(problem.clone(), load(), PathOptions::window(at, 1.0)).unwrap();
-        fresh.start(at, None).expect("fresh start");
-        let want = fresh.start_state().expect("start state");
-        assert_eq!(
-            sols[0].state.classes, want.classes,
-            "{ctx}: classes at {at}"
-        );
-        let scale = want.lambda_n.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        for (a, b) in sols[0]
-            .state
-            .lambda_n
-            .iter()
-            .chain(&sols[0].state.lambda_t)
-            .zip(want.lambda_n.iter().chain(&want.lambda_t))
-        {
-            assert!((a - b).abs() <= 1e-10 * scale, "{ctx}: λ {a} vs {b}");
-        }
+        let want = fresh_after_zero(&mut path, &problem, load, &ctx);
         // Whether the directional problem's answer is not the trivial one: some nodes
         // keep sticking.
         let slipping = want
@@ -570,10 +589,7 @@ fn vertex_nodes_beside_nodes_at_their_friction_limit() {
         let m = 2 * p;
         let friction = [0.1, 0.3, 0.6, 1.0, 3.0][rng.int(0, 4)];
         let coupling = rng.range(0.5, 4.0);
-        let g = nalgebra::DMatrix::<f64>::from_fn(m, m, |_, _| rng.range(-1.0, 1.0));
-        let d = nalgebra::DVector::<f64>::from_fn(m, |_, _| rng.range(1.0, 2.0));
-        let w = nalgebra::DMatrix::from_diagonal(&d) + &g * g.transpose() * (coupling / m as f64);
-        let w = (&w + w.transpose()) * 0.5;
+        let w = coupled_w(&mut rng, m, coupling);
         // On the all-stick piece d = 0 and λ(α) = λ* + α y, for q(α) = −W (λ* + α y).
         let (mut lam0, mut y) = (vec![0.0; m], vec![0.0; m]);
         for i in 0..p {
@@ -632,33 +648,7 @@ fn vertex_nodes_beside_nodes_at_their_friction_limit() {
                 at_zero.count() >= nv,
                 "{ctx}: the vertex nodes' events at α = 0"
             );
-            let next = path
-                .events()
-                .iter()
-                .map(|e| e.alpha)
-                .find(|&a| a > 1e-12)
-                .unwrap_or(1.0);
-            let at = 0.5 * next;
-            let sols = path.solutions_at(at).expect("solutions_at");
-            assert_eq!(sols.len(), 1, "{ctx}: one solution at {at}");
-            let mut fresh =
-                Path::new(problem.clone(), load(), PathOptions::window(at, 1.0)).unwrap();
-            fresh.start(at, None).expect("fresh start");
-            let want = fresh.start_state().expect("start state");
-            assert_eq!(
-                sols[0].state.classes, want.classes,
-                "{ctx}: classes at {at}"
-            );
-            let scale = want.lambda_n.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-            for (a, b) in sols[0]
-                .state
-                .lambda_n
-                .iter()
-                .chain(&sols[0].state.lambda_t)
-                .zip(want.lambda_n.iter().chain(&want.lambda_t))
-            {
-                assert!((a - b).abs() <= 1e-10 * scale, "{ctx}: λ {a} vs {b}");
-            }
+            fresh_after_zero(&mut path, &problem, load, &ctx);
         }
     }
 }
