@@ -19,7 +19,7 @@
 //! 5. Otherwise: [`crate::Error::SolveFailed`] saying what each stage reached.
 //!
 //! A returned `λ` always satisfies `‖H‖∞ ≤ 1e-12` relative to its force scale, or is the
-//! caller's polish of a stalled iterate (see [`solve_fixed_alpha`]).
+//! caller's polish of a stalled iterate (see `solve_fixed_alpha`).
 
 use faer::MatRef;
 

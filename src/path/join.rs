@@ -317,8 +317,9 @@ impl Path {
     /// when there are more than two of them: the continuation from such a point is
     /// positively homogeneous, so their classes are read off the solution of the
     /// directional contact problem `ḋ = W λ̇ ± q'` (the other nodes keep their class).
-    /// Where the other nodes are still too many and each fits two classes, theirs come
-    /// from [`Self::pivoted_classes`].
+    /// Where the other nodes have more than [`MAX_DIRECTIONAL_COMBINATIONS`] combinations
+    /// of classes and each fits two, theirs come from [`Self::pivoted_classes`] (and from
+    /// the enumeration, up to [`MAX_CANDIDATE_PIECES`], where that finds none).
     #[allow(clippy::too_many_arguments)]
     fn continuations(
         &self,
@@ -451,7 +452,8 @@ impl Path {
 
     /// The classes of the piece that continues the path from `pt` with α moving along
     /// `want` (±1), where more nodes are at a boundary between two classes than
-    /// [`MAX_CANDIDATE_PIECES`] lets [`Self::continuations`] enumerate: `nodes` fit the
+    /// [`Self::continuations`] enumerates ([`MAX_CANDIDATE_PIECES`] pieces, or
+    /// [`MAX_DIRECTIONAL_COMBINATIONS`] beside nodes at a vertex): `nodes` fit the
     /// classes `options` (one or two each, or all four at a zero-force vertex, `vertex`:
     /// those take theirs from [`Self::directional_classes`] with the others' classes at
     /// each step), every other node keeps its class in `fixed`.

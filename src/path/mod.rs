@@ -919,8 +919,9 @@ pub(crate) fn overflow_hint(big: f64) -> String {
 /// over the nodes at a class boundary of the number of classes that fit there). Beyond it,
 /// nodes at a zero-force vertex are handled by the directional problem (one solution per
 /// way along α), and only the other nodes are enumerated; where those are still too many
-/// and each fits two classes, they take theirs by pivoting (`Path::pivoted_classes`, the
-/// vertex nodes' classes from the directional problem at each step).
+/// (beyond [`MAX_DIRECTIONAL_COMBINATIONS`]) and each fits two classes, they take theirs
+/// by pivoting (`Path::pivoted_classes`, the vertex nodes' classes from the directional
+/// problem at each step).
 const MAX_CANDIDATE_PIECES: usize = 4096;
 
 /// Where the vertex nodes take their classes from the directional problem, the largest
