@@ -488,7 +488,19 @@ pub(crate) fn solve_fixed_alpha(
     alpha: f64,
     polish: Polish<'_>,
 ) -> Result<Vec<f64>> {
-    solve_with_frozen(problem, qg, guess, alpha, None, None, polish).map(|(lam, _)| lam)
+    solve_with_frozen(problem, qg, guess, alpha, None, Stages::All, None, polish)
+        .map(|(lam, _)| lam)
+}
+
+/// Which stages of [`solve_with_frozen`] run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Stages {
+    /// Newton, the active-set iteration, Newton again, and 20 rounds of Gauss–Seidel
+    /// sweeps and Newton (a first pass: where these fail, so does the solve).
+    First,
+    /// Every stage, down to the continuation in the friction coefficients, the long
+    /// Gauss–Seidel run and the restarts.
+    All,
 }
 
 /// See [`solve_fixed_alpha`]: a last chance for a stalled iterate.
@@ -498,20 +510,31 @@ pub(crate) type Polish<'a> = Option<&'a mut dyn FnMut(&[f64]) -> Option<Vec<f64>
 /// by updates of `seed` where given (a factorisation of a nearby piece: the path's, for
 /// the directional problem at a vertex, so that it costs O(m²) per piece, not O(m³)).
 /// Also returns the factorisation of the last piece it solved, where any (a seed for the
-/// next solve nearby, see [`newton_near`]).
+/// next solve nearby, see [`newton_near`]). With [`Stages::First`] it fails where the
+/// first stages do, without the costly last ones.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn solve_with_frozen(
     problem: &crate::problem::Problem,
     qg: &[f64],
     guess: Option<&[f64]>,
     alpha: f64,
     fr: Frozen<'_>,
+    stages: Stages,
     seed: Option<UpdatedLu>,
     polish: Polish<'_>,
 ) -> Result<(Vec<f64>, Option<UpdatedLu>)> {
     let c = PieceConstants::of(problem);
     let w_row_sums = problem.w_row_sums();
     let mut pieces = PieceSolves::new(&c, problem.delassus().w(), w_row_sums, seed);
-    let lam = solve_stages(&mut pieces, w_row_sums, qg, guess, alpha, fr, polish)?;
+    let lam = solve_stages(
+        &mut pieces,
+        w_row_sums,
+        qg,
+        guess,
+        alpha,
+        (fr, stages),
+        polish,
+    )?;
     Ok((lam, pieces.lu))
 }
 
@@ -541,7 +564,7 @@ fn solve_stages(
     qg: &[f64],
     guess: Option<&[f64]>,
     alpha: f64,
-    fr: Frozen<'_>,
+    (fr, stages): (Frozen<'_>, Stages),
     mut polish: Polish<'_>,
 ) -> Result<Vec<f64>> {
     let (c, w) = (pieces.c, pieces.w);
@@ -576,6 +599,12 @@ fn solve_stages(
     }
     if let Some(lam) = polished(&lam) {
         return Ok(lam);
+    }
+    if stages == Stages::First {
+        return Err(Error::SolveFailed {
+            alpha,
+            message: notes.join("; "),
+        });
     }
     // The continuation in the friction coefficients before the long Gauss-Seidel run: on
     // a p = 1000 strip with F = 5, mid-load, Newton stalled at a residual of 1e-6 and

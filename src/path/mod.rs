@@ -25,7 +25,7 @@ use crate::error::{Error, Result};
 use crate::load::{BoundLoad, Load, LoadSnapshot};
 use crate::piece::{DenseLu, Guard, PieceConstants, PieceLu, displacement_gaps, shift_gap};
 use crate::problem::Problem;
-use crate::solve::{newton_near, solve_fixed_alpha, solve_with_frozen};
+use crate::solve::{Stages, newton_near, solve_fixed_alpha, solve_with_frozen};
 use std::cell::{Cell, RefCell};
 use update::UpdatedLu;
 
