@@ -410,6 +410,11 @@ impl Path {
         // stages run only where that pass finds no continuation and cut a solve short.
         // (In double on the strip of `MAX_DIRECTIONAL_COMBINATIONS`, solves that failed
         // after every stage, about 1 s each, were 61 s of 100.)
+        // (the nodes whose classes the directional problem gives, by node)
+        let mut free = vec![false; fixed.len()];
+        for (k, &i) in nodes.iter().enumerate() {
+            free[i] = use_directional && is_vertex[k];
+        }
         for quick in [use_directional, false] {
             let mut out = Vec::new();
             let mut cut = false;
@@ -420,14 +425,10 @@ impl Path {
                     classes[nodes[e]] = options[e][idx[k]];
                 }
                 if use_directional {
-                    let frozen: Vec<Option<Class>> = (0..classes.len())
-                        .map(|i| {
-                            let v = nodes
-                                .iter()
-                                .position(|&n| n == i)
-                                .is_some_and(|k| is_vertex[k]);
-                            (!v).then_some(classes[i])
-                        })
+                    let frozen: Vec<Option<Class>> = classes
+                        .iter()
+                        .zip(&free)
+                        .map(|(&c, &f)| (!f).then_some(c))
                         .collect();
                     for s in [1.0, -1.0] {
                         match self.directional_classes(pt, &frozen, s, quick) {
