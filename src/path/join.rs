@@ -39,6 +39,15 @@ const NEAR_VANISHING: f64 = 1e-6;
 /// (see [`Path::directional_classes`]) before it is solved from zero forces.
 const NEAR_NEWTON_ITERATIONS: usize = 20;
 
+#[cfg(test)]
+thread_local! {
+    /// Test switch: every directional solve of the enumeration's first pass fails, as
+    /// where only the solver's last stages solve the directional problem; the count of
+    /// solves it refused (see `tests::the_second_pass_finds_what_the_first_misses`).
+    static FIRST_PASS_REFUSES: std::cell::Cell<Option<usize>> =
+        const { std::cell::Cell::new(None) };
+}
+
 /// A directional solution of the current point (see `Path::directional_warm`).
 pub(super) struct DirectionalWarm {
     /// The way along α (±1).
@@ -583,6 +592,11 @@ impl Path {
         s: f64,
         quick: bool,
     ) -> std::result::Result<Vec<Class>, bool> {
+        #[cfg(test)]
+        if let Some(n) = FIRST_PASS_REFUSES.get().filter(|_| quick) {
+            FIRST_PASS_REFUSES.set(Some(n + 1));
+            return Err(true);
+        }
         let qdir: Vec<f64> = pt.dq.iter().map(|v| s * v).collect();
         // From the last solution of this point's problem along this way (for other
         // classes of the frozen nodes, which most combinations and pivoting steps change
@@ -1440,5 +1454,78 @@ impl Path {
         let tr = self.trace.as_mut().expect("started");
         tr.pending = Some(pend);
         res.map(|_| ())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::FIRST_PASS_REFUSES;
+    use crate::{Class, EndReason, Load, Path, PathOptions, ProblemBuilder};
+    use std::sync::Arc;
+
+    /// Decoupled nodes (W = I/2, F = 1/2, condensed): `nv` nodes touch down at α = 1/2
+    /// (`qν = −1/4 + α/2`, `qt = −1/20 + α/10`) and `ns` nodes, pressed (`qν = 1/2`) and
+    /// sheared (`qt = α/2`), reach their cone's edge there. By hand: before α = 1/2 the
+    /// touching nodes are open and the sheared ones stick (`λ = −2q`, `|λt| = α ≤ F |λν| =
+    /// 1`); after it the touching nodes stick (`λ = −2q`, `|λt| = |λν|/5`) and the sheared
+    /// ones slip in +t (`λν = −1`, `λt = −1/2`). With 6 nodes at the vertex and 3 at the
+    /// cone's edge (4^6 · 2^3 neighbouring pieces, beyond the 4096 enumerated), the vertex
+    /// nodes take their classes from the directional problem for each of the 8
+    /// combinations of the others'. Here the enumeration's first pass (the solver's first
+    /// stages) is made to find nothing, as where only the last stages solve those
+    /// directional problems: the pass with every stage must still find the continuation.
+    #[test]
+    fn the_second_pass_finds_what_the_first_misses() {
+        let (nv, ns) = (6, 3);
+        let p = nv + ns;
+        let w = faer::Mat::<f64>::from_fn(2 * p, 2 * p, |i, j| if i == j { 0.5 } else { 0.0 });
+        let problem = Arc::new(
+            ProblemBuilder::condensed(w)
+                .friction_uniform(0.5)
+                .build()
+                .expect("problem"),
+        );
+        let (mut q0, mut q1) = (vec![0.0; 2 * p], vec![0.0; 2 * p]);
+        q0[..ns].fill(0.5);
+        q1[p..p + ns].fill(0.5);
+        q0[ns..p].fill(-0.25);
+        q1[ns..p].fill(0.5);
+        q0[p + ns..].fill(-0.05);
+        q1[p + ns..].fill(0.1);
+        FIRST_PASS_REFUSES.set(Some(0));
+        let mut path = Path::new(
+            problem,
+            Load::affine(q0, q1).unwrap(),
+            PathOptions::window(0.0, 1.0),
+        )
+        .expect("path");
+        let traced = path.start(0.0, None).and_then(|_| path.run());
+        let refused = FIRST_PASS_REFUSES.replace(None).expect("set above");
+        traced.expect("trace");
+        assert!(refused > 0, "the first pass was never asked");
+        assert_eq!(path.end_reason(), Some(&EndReason::Window));
+        assert_eq!(path.events().len(), p, "one event per node");
+        for e in path.events() {
+            assert!((e.alpha - 0.5).abs() <= 1e-15, "event at α = {}", e.alpha);
+            let want = if e.node < ns {
+                (Class::Stick, Class::SlipPlus)
+            } else {
+                (Class::Open, Class::Stick)
+            };
+            assert_eq!((e.from, e.to), want, "node {}", e.node);
+        }
+        let sols = path.solutions_at(1.0).expect("solutions_at");
+        assert_eq!(sols.len(), 1);
+        let st = &sols[0].state;
+        for i in 0..p {
+            let want = if i < ns { (-1.0, -0.5) } else { (-0.5, -0.1) };
+            assert!(
+                (st.lambda_n[i] - want.0).abs() <= 1e-15
+                    && (st.lambda_t[i] - want.1).abs() <= 1e-15,
+                "node {i}: λ = ({}, {})",
+                st.lambda_n[i],
+                st.lambda_t[i]
+            );
+        }
     }
 }
