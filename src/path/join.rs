@@ -1467,7 +1467,7 @@ mod tests {
     /// (`qν = −1/4 + α/2`, `qt = −1/20 + α/10`) and `ns` nodes, pressed (`qν = 1/2`) and
     /// sheared (`qt = α/2`), reach their cone's edge there. By hand: before α = 1/2 the
     /// touching nodes are open and the sheared ones stick (`λ = −2q`, `|λt| = α ≤ F |λν| =
-    /// 1`); after it the touching nodes stick (`λ = −2q`, `|λt| = |λν|/5`) and the sheared
+    /// 1/2`); after it the touching nodes stick (`λ = −2q`, `|λt| = |λν|/5`) and the sheared
     /// ones slip in +t (`λν = −1`, `λt = −1/2`). With 6 nodes at the vertex and 3 at the
     /// cone's edge (4^6 · 2^3 neighbouring pieces, beyond the 4096 enumerated), the vertex
     /// nodes take their classes from the directional problem for each of the 8
