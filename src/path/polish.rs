@@ -55,6 +55,11 @@ const STALLED: f64 = 1e-20;
 const ROUGH: f64 = 0.25;
 /// See [`near`].
 const NEAR: f64 = 1e-5;
+/// A round whose correction is above this fraction of the last one (in the first round:
+/// of the solution) makes the rest of the refinement use checked solves (see
+/// [`SolveFn`]): plain solves of the updated factorisation contract by κ ε, and the
+/// check's second solve then pays for itself only where that is slow, near folds.
+const SLOW: f64 = 1e-3;
 
 /// A vector in double-double, as its high and low parts.
 #[derive(Clone)]
@@ -130,8 +135,11 @@ fn eval_dd(f: &LinForm, lam: &DdVec, d: &DdVec) -> Dd {
 }
 
 /// The piece's solves `b ↦ M_S⁻¹ b` for several columns at once (seed's row scaling),
-/// with W times each solution where the solve computed it to check itself.
-type SolveFn<'a> = dyn Fn(&[Vec<f64>]) -> (Vec<Vec<f64>>, Option<Vec<Vec<f64>>>) + 'a;
+/// with W times each solution where the solve computed it to check itself. With
+/// `checked` (the updated factorisation's solves only), each solve is checked by its
+/// residual and refined once in double where that is above rounding level (see
+/// [`Refiner::refine_by`]).
+type SolveFn<'a> = dyn Fn(&[Vec<f64>], bool) -> (Vec<Vec<f64>>, Option<Vec<Vec<f64>>>) + 'a;
 type PieceSolve<'a> = Box<SolveFn<'a>>;
 
 /// What a refinement on one piece needs: the constants, W (both parts), the load's
@@ -239,12 +247,14 @@ impl Refiner<'_> {
     /// early. Only the first round's test, whose correction stands for the contraction,
     /// stays relative to max|x| (a tiny x then takes more rounds).
     ///
-    /// Where the piece's solves are its updated factorisation and the refinement fails,
-    /// it is tried again with a fresh LU of the piece matrix (O(m³), once): an updated
-    /// solve is a poorer approximate inverse on a nearly singular piece (near a fold of the
-    /// 1201 × 11 strip, F = 5, rate corrections of 2.0e-2 and then 2.7e-2 did not contract
-    /// where a fresh LU's did, and the exit kept in double, 2e-5 in α off, made the path
-    /// turn back at a fold it does not have).
+    /// Where the piece's solves are its updated factorisation, the refinement starts with
+    /// plain solves and turns to checked ones at the first slow round (see [`SLOW`]);
+    /// where it fails, it is tried again with checked solves from the start, and then
+    /// with a fresh LU of the piece matrix (O(m³), once): an updated solve is a poorer
+    /// approximate inverse on a nearly singular piece (near a fold of the 1201 × 11 strip,
+    /// F = 5, rate corrections of 2.0e-2 and then 2.7e-2 did not contract where a fresh
+    /// LU's did, and the exit kept in double, 2e-5 in α off, made the path turn back at a
+    /// fold it does not have).
     fn refine_all(&self, pairs: Vec<(DdVec, DdVec)>) -> Option<Vec<(DdVec, DdVec)>> {
         self.refine_all_known(pairs, &[])
     }
@@ -257,22 +267,26 @@ impl Refiner<'_> {
         known: &[Option<DdVec>],
     ) -> Option<Vec<(DdVec, DdVec)>> {
         if !self.updated {
-            return self.refine_by(&self.solve, pairs, known);
+            return self.refine_by(&self.solve, pairs, known, true);
         }
-        self.refine_by(&self.solve, pairs.clone(), known)
+        self.refine_by(&self.solve, pairs.clone(), known, false)
+            .or_else(|| self.refine_by(&self.solve, pairs.clone(), known, true))
             .or_else(|| {
                 let lu = DenseLu::new(self.c.piece_matrix(self.w, self.classes).as_ref());
-                let fresh = |bs: &[Vec<f64>]| (bs.iter().map(|b| lu.solve(b)).collect(), None);
-                self.refine_by(&fresh, pairs, known)
+                let fresh = |bs: &[Vec<f64>], _| (bs.iter().map(|b| lu.solve(b)).collect(), None);
+                self.refine_by(&fresh, pairs, known, true)
             })
     }
 
-    /// [`Self::refine_all_known`] with the piece's solves `solve`.
+    /// [`Self::refine_all_known`] with the piece's solves `solve`, checked ones from the
+    /// first round with `checked`, else from the first round that contracts by less than
+    /// [`SLOW`].
     fn refine_by(
         &self,
         solve: &SolveFn<'_>,
         pairs: Vec<(DdVec, DdVec)>,
         known: &[Option<DdVec>],
+        mut checked: bool,
     ) -> Option<Vec<(DdVec, DdVec)>> {
         let floors: Vec<f64> = pairs.iter().map(|(_, c)| self.floor(c)).collect();
         let known_d = |j: usize| known.get(j).and_then(|d| d.as_ref());
@@ -311,7 +325,7 @@ impl Refiner<'_> {
                 })
                 .collect();
             // (W δ from the checked solve's own residual where it has it)
-            let (dxs, wdxs) = solve(&rs);
+            let (dxs, wdxs) = solve(&rs, checked);
             let wdx = match wdxs {
                 Some(w) if w.len() == dxs.len() => w,
                 _ => mat_mul(self.w, &dxs.iter().map(|v| &v[..]).collect::<Vec<_>>()),
@@ -353,6 +367,7 @@ impl Refiner<'_> {
                 // rate corrected by 4.5e-4 of itself on a slender strip kept 4.3e-6 of error
                 // and its exit was 4.7e-9 in α off the independent reference.)
                 let before = if last[j].is_finite() { last[j] } else { size };
+                checked |= step > SLOW * before;
                 let predicted = step * (step / before) <= CONVERGED * scale;
                 if step <= CONVERGED * scale || predicted {
                     done[j] = true;
@@ -505,9 +520,14 @@ impl Path {
         let row_bound = self.row_bound();
         let solve: PieceSolve<'a> = match updated {
             // Checked solves (each refined once in double where its residual is above
-            // rounding level): each outer round then contracts by about (κ ε)², not κ ε,
-            // on pieces near the limit of double precision.
-            Some(u) => Box::new(move |bs: &[Vec<f64>]| {
+            // rounding level) contract by about (κ ε)² per outer round, not κ ε, on
+            // pieces near the limit of double precision; plain ones cost half as much
+            // where the check would refine (a quarter of the columns on the p = 480
+            // strip) and contract as fast elsewhere.
+            Some(u) => Box::new(move |bs: &[Vec<f64>], checked: bool| {
+                if !checked {
+                    return (u.solve_many(&c, bs), None);
+                }
                 let cols: Vec<update::Rhs<'_>> =
                     bs.iter().map(|b| update::Rhs { b, guess: None }).collect();
                 let (xs, wxs) = u
@@ -519,7 +539,7 @@ impl Path {
             }),
             None => {
                 let lu = DenseLu::new(c.piece_matrix(w, classes).as_ref());
-                Box::new(move |bs: &[Vec<f64>]| (bs.iter().map(|b| lu.solve(b)).collect(), None))
+                Box::new(move |bs: &[Vec<f64>], _| (bs.iter().map(|b| lu.solve(b)).collect(), None))
             }
         };
         Some(Refiner {
