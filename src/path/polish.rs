@@ -879,3 +879,115 @@ impl Path {
         (alpha.is_finite() && lam.iter().all(|v| v.is_finite())).then_some((lam, alpha, g))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ProblemBuilder;
+    use std::cell::Cell;
+
+    type Counted = (Option<Vec<f64>>, Vec<f64>, usize, usize);
+
+    /// A refiner of the sticking piece of a 3-node condensed problem (W symmetric positive
+    /// definite, affine load), whose solves are `lu.solve(b)` times `plain` where the
+    /// refinement asks for plain solves and exact ones where it asks for checked solves,
+    /// counting both; the pair to refine is the point at α = 0.3, off by 1e-6 of itself.
+    /// Returns the refined point (rounded), the point solved in double, and the numbers of
+    /// plain and checked solves. With `start_plain`, as the path refines (plain solves
+    /// first), else checked solves from the first round.
+    fn refine_counting(plain: f64, start_plain: bool) -> Counted {
+        let p = 3;
+        let w = faer::Mat::<f64>::from_fn(2 * p, 2 * p, |i, j| {
+            let (a, b) = (i.min(j) as f64, i.max(j) as f64);
+            if i == j {
+                4.0 + a
+            } else {
+                0.3 * (1.0 + a + 2.0 * b).sin()
+            }
+        });
+        let problem = ProblemBuilder::condensed(w)
+            .friction_uniform(0.5)
+            .build()
+            .expect("problem");
+        let classes = vec![Class::Stick; p];
+        let c = PieceConstants::of(&problem);
+        let w = problem.delassus().w();
+        let q0: Vec<f64> = (0..2 * p).map(|k| 0.1 * (k as f64 + 1.0).cos()).collect();
+        let q1: Vec<f64> = (0..2 * p).map(|k| 0.2 * (k as f64 * 0.7).sin()).collect();
+        let lu = DenseLu::new(c.piece_matrix(w, &classes).as_ref());
+        let (plain_calls, checked_calls) = (Cell::new(0), Cell::new(0));
+        let solve = |bs: &[Vec<f64>], checked: bool| {
+            let (calls, f) = if checked {
+                (&checked_calls, 1.0)
+            } else {
+                (&plain_calls, plain)
+            };
+            calls.set(calls.get() + 1);
+            let xs = bs
+                .iter()
+                .map(|b| lu.solve(b).into_iter().map(|v| v * f).collect())
+                .collect();
+            (xs, None)
+        };
+        let r = Refiner {
+            c,
+            w,
+            w_lo: None,
+            classes: &classes,
+            solve: Box::new(solve),
+            updated: true,
+            q: vec![(q0, vec![0.0; 2 * p]), (q1, vec![0.0; 2 * p])],
+            gap: problem.gap_equilibrated(),
+        };
+        // Sticking: d = W λ + q(α) − (g, 0) = 0 (g = 0 here), so λ = −W⁻¹ q(α), solved
+        // here in double with an LU of W itself.
+        let cst = r.point_constant(0.3);
+        let minus_q: Vec<f64> = (0..2 * p).map(|k| -cst.get(k).to_f64()).collect();
+        let exact = DenseLu::new(w).solve(&minus_q);
+        let guess: Vec<f64> = exact.iter().map(|v| v * (1.0 + 1e-6)).collect();
+        let pairs = vec![(DdVec::from(&guess), cst)];
+        let out = if start_plain {
+            r.refine_all_known(pairs, &[])
+        } else {
+            r.refine_by(&r.solve, pairs, &[], true)
+        };
+        let x = out.map(|mut v| v.pop().expect("one pair").0.rounded());
+        (x, exact, plain_calls.get(), checked_calls.get())
+    }
+
+    #[test]
+    fn a_slowly_contracting_refinement_turns_to_checked_solves() {
+        // Plain solves 10% too long contract by 0.1 per round: the first correction is
+        // 1.1e-6 of the point, the second 1/10 of the first, slower than SLOW, and the
+        // rest are checked (exact here). Without the turn, plain rounds would go on for
+        // about 16 rounds.
+        let (x, exact, plain, checked) = refine_counting(1.1, true);
+        let x = x.expect("converges");
+        let scale = inf_norm(&exact);
+        for (a, b) in x.iter().zip(&exact) {
+            assert!((a - b).abs() <= 1e-13 * scale, "{a} vs {b}");
+        }
+        assert!(plain <= 2, "{plain} plain solves");
+        assert!(checked >= 1, "{checked} checked solves");
+    }
+
+    #[test]
+    fn a_failed_plain_refinement_is_retried_with_checked_solves() {
+        // Plain solves of the wrong sign double the guess's error: the second correction
+        // is twice the first and the refinement fails (it stopped contracting). It is
+        // retried with checked solves, before a fresh LU (which would leave the checked
+        // count at 0).
+        let (x, exact, plain, checked) = refine_counting(-1.0, true);
+        let x = x.expect("converges");
+        let scale = inf_norm(&exact);
+        for (a, b) in x.iter().zip(&exact) {
+            assert!((a - b).abs() <= 1e-13 * scale, "{a} vs {b}");
+        }
+        assert!(plain >= 1, "{plain} plain solves");
+        assert!(checked >= 1, "{checked} checked solves");
+        // And a refinement that asks for checked solves from the start uses no plain one.
+        let (x, _, plain, _) = refine_counting(-1.0, false);
+        assert!(x.is_some());
+        assert_eq!(plain, 0);
+    }
+}
