@@ -324,6 +324,29 @@ fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
     }
 }
 
+/// Starts where every stage of the fixed-α solver fails, at α = 4 and at every nearby α
+/// (F = 5: a body in a corner, p = 35, and a curved foundation, p = 24, traced from 4 to
+/// −2), are reached from zero load (see `Path::start`): the start and the whole path
+/// agree with the independent tracer of `tests/common/reference.rs`, which checks that
+/// the start's piece reproduces fricont's start λ with every guard positive. Before,
+/// `Path::start` returned `SolveFailed` on both. (A sweep of 20,000 seeds of this file's
+/// families against that tracer, with reversed windows and rows scaled by 1e-6 … 1e6,
+/// found these two; every other trace agreed, three of them from another solution of a
+/// start with several, whose path agreed with the reference too.)
+#[test]
+fn starts_where_every_stage_fails_are_reached_from_zero_load() {
+    let mut curved = curved_foundation(8066);
+    (curved.a0, curved.a1) = (curved.a1, curved.a0);
+    for (ctx, case) in [
+        ("corner seed 11939", in_a_corner(11939)),
+        ("curved foundation seed 8066, reversed", curved),
+    ] {
+        assert_eq!((case.a0, case.data.friction[0]), (4.0, 5.0), "{ctx}");
+        let c = against_the_reference(ctx, &case);
+        assert!(c.fricont.len() >= 5, "{ctx}: {} events", c.fricont.len());
+    }
+}
+
 /// `case` traced by fricont (default options) and by the independent tracer of
 /// `tests/common/reference.rs` on its window: the same start, the same transitions at the
 /// same α to 1e-9 relative to max(1, |α|), and fricont ending at the window's end.

@@ -1702,13 +1702,69 @@ impl Path {
     /// `alpha`, `max(‖q‖∞ / ‖q'‖∞, |alpha − alpha_start|)`, where that is shorter, toward
     /// `alpha_end` first) and traces the path from there back to `alpha`: its point there
     /// is the start.
+    /// Where that fails too, the start is reached from zero load: the path of the same
+    /// problem under the load `τ f(alpha)` is traced from τ = 0 (zero forces, where every
+    /// gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1 is the start.
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
-    /// fails (also from every nearby α), the load fails, no piece leaves the start point
-    /// toward `alpha_end`.
+    /// fails (also from every nearby α and from zero load), the load fails, no piece
+    /// leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
         match self.start_solved(alpha, guess) {
-            Err(Error::SolveFailed { message, .. }) => self.start_from_nearby(alpha, message),
+            Err(Error::SolveFailed { message, .. }) => {
+                match self.start_from_nearby(alpha, message) {
+                    Err(Error::SolveFailed { message, .. }) => {
+                        self.start_from_zero_load(alpha, message)
+                    }
+                    r => r,
+                }
+            }
             r => r,
+        }
+    }
+
+    /// The fixed-α solver can fail where the path from nearby α fails as well: on a body
+    /// in a corner (p = 35, F = 5) and on a curved foundation (p = 24, F = 5) every stage
+    /// stalled at α = 4 (residuals 2e-4 to 9e-2) and at every nearby α, while the path of
+    /// the load `τ f(4)` from τ = 0 reached τ = 1 in 9 and 13 transitions (two folds each).
+    /// At τ = 0 the load is zero, and where every gap is ≥ 0 the forces are zero: a start
+    /// the solver finds at once, and the only solution there (with no load, forces that
+    /// satisfy the contact and friction conditions do no positive work, `λᵀ W λ ≤ 0`, and
+    /// W is positive definite). The path cannot come back to τ = 0 through another
+    /// solution, and the solutions stay bounded, so (barring a bifurcation on the way) it
+    /// reaches τ = 1, where its point solves the problem at `alpha`; that point is the
+    /// start's guess (kept by the solver as it solves the problem). The ray's path is a
+    /// path of its own (an affine load `0 + τ f(alpha)`, window [0, 1], this path's other
+    /// options); its events are dropped. Where it does not reach τ = 1: `SolveFailed` with
+    /// `failed` and where it ended.
+    fn start_from_zero_load(&mut self, alpha: f64, failed: String) -> Result<()> {
+        let f = self.load.force(alpha)?;
+        let ray = Load::affine(vec![0.0; f.len()], f)?;
+        let opts = PathOptions {
+            alpha_start: 0.0,
+            alpha_end: 1.0,
+            max_alpha_step: None,
+            ..self.opts.clone()
+        };
+        let mut sub = Path::new(self.problem.clone(), ray, opts)?;
+        let end = match sub.start_solved(0.0, None).and_then(|_| sub.run()) {
+            Ok(EndReason::Window) => match sub.pieces().last() {
+                Some(pc) if pc.alpha_to == 1.0 => Ok(pc.lambda_to.clone()),
+                Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
+                None => Err("it traced no piece".to_string()),
+            },
+            Ok(r) => Err(format!("it ended ({})", r.name())),
+            // The host's load failed: its error, not the solver's.
+            Err(e @ Error::Load { .. }) => return Err(e),
+            Err(e) => Err(e.to_string()),
+        };
+        match end {
+            Ok(lam) => self.start_solved(alpha, Some(&lam)),
+            Err(why) => Err(Error::SolveFailed {
+                alpha,
+                message: format!(
+                    "{failed}; the path from zero load, tau f(alpha) for tau from 0 to 1, did not reach it: {why}"
+                ),
+            }),
         }
     }
 
