@@ -58,7 +58,10 @@ const NEAR: f64 = 1e-5;
 /// A round whose correction is above this fraction of the last one (in the first round:
 /// of the solution) makes the rest of the refinement use checked solves (see
 /// [`SolveFn`]): plain solves of the updated factorisation contract by κ ε, and the
-/// check's second solve then pays for itself only where that is slow, near folds.
+/// check's second solve then pays for itself only where that is slow, near folds. On the
+/// 1201 × 11 strip (F = 5, κ(W) 6.4e10, through its folds) 235 of the first 1500
+/// refinements of updated pieces turned to checked solves, and none failed (counted with a
+/// scratch counter; no retry with checked solves, no fresh LU).
 const SLOW: f64 = 1e-3;
 
 /// A vector in double-double, as its high and low parts.
