@@ -816,8 +816,10 @@ pub unsafe extern "C" fn fricont_path_set_monitor(
 /// `alpha_end` first, inside the window) and traces the path from there back to `alpha`:
 /// the point it reaches is the start. Where none leads there, it traces the path of the
 /// load `τ f(alpha)` from zero load (τ = 0, zero forces where every gap is ≥ 0) to τ = 1,
-/// through its folds, and its point at τ = 1 is the start (`FRICONT_ERR_SOLVE_FAILED`
-/// only where that fails too; the message says what each attempt reached).
+/// through its folds, and its point at τ = 1 is the start; where that path cannot leave
+/// τ = 0 (every gap zero: every node at the vertex of its cone), the same ray from a load
+/// that holds every node open (`FRICONT_ERR_SOLVE_FAILED` only where that fails too; the
+/// message says what each attempt reached).
 ///
 /// The problem at one α can have several solutions (large friction, a path that folds
 /// back over `alpha`); the solver returns one of them, and which one can depend on

@@ -1704,7 +1704,10 @@ impl Path {
     /// is the start.
     /// Where that fails too, the start is reached from zero load: the path of the same
     /// problem under the load `τ f(alpha)` is traced from τ = 0 (zero forces, where every
-    /// gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1 is the start.
+    /// gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1 is the start; where
+    /// that path does not get there (it cannot leave τ = 0 where every gap is zero), the
+    /// same ray from a load that holds every node open at τ = 0 (on the equilibrated W
+    /// in double; its point at τ = 1 is the start's guess).
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails (also from every nearby α and from zero load), the load fails, no piece
     /// leaves the start point toward `alpha_end`.
@@ -1734,8 +1737,9 @@ impl Path {
     /// reaches τ = 1, where its point solves the problem at `alpha`; that point is the
     /// start's guess (kept by the solver as it solves the problem). The ray's path is a
     /// path of its own (an affine load `0 + τ f(alpha)`, window [0, 1], this path's other
-    /// options); its events are dropped. Where it does not reach τ = 1: `SolveFailed` with
-    /// `failed` and where it ended.
+    /// options); its events are dropped. Where it does not reach τ = 1, the ray from every
+    /// node open ([`Self::ray_from_open`]); where neither does: `SolveFailed` with `failed`
+    /// and where each ended.
     fn start_from_zero_load(&mut self, alpha: f64, failed: String) -> Result<()> {
         let f = self.load.force(alpha)?;
         let ray = Load::affine(vec![0.0; f.len()], f)?;
@@ -1757,6 +1761,12 @@ impl Path {
             Err(e @ Error::Load { .. }) => return Err(e),
             Err(e) => Err(e.to_string()),
         };
+        let end = match end {
+            Ok(lam) => Ok(lam),
+            Err(why) => self.ray_from_open(alpha).map_err(|why2| {
+                format!("{why}; the path from every node open, on W in double, did not reach it either: {why2}")
+            }),
+        };
         match end {
             Ok(lam) => self.start_solved(alpha, Some(&lam)),
             Err(why) => Err(Error::SolveFailed {
@@ -1765,6 +1775,57 @@ impl Path {
                     "{failed}; the path from zero load, tau f(alpha) for tau from 0 to 1, did not reach it: {why}"
                 ),
             }),
+        }
+    }
+
+    /// The ray of [`Self::start_from_zero_load`] where its own start fails: where every
+    /// gap is zero, zero load puts every node at the vertex of its cone (zero force and
+    /// zero gap), and no piece may leave that point (on a body in a corner, p = 24, F = 5,
+    /// α = 20, the directional problem of 24 nodes at once found none). This ray starts
+    /// with every node open instead: on the equilibrated problem (W, gaps and friction of
+    /// the internal rows, in double), the condensed load `(1 − τ) q_open + τ q(alpha)`,
+    /// where `q_open` pulls every node away from contact (`q_open,ν = −s + min(0, g)`,
+    /// s = max(‖q(alpha)‖∞, ‖g‖∞), tangential rows 0: at zero forces `d_ν = −s − max(0, g)
+    /// ≤ −s` at every node, so the forces are zero at τ = 0 and no node is at a vertex;
+    /// that solution is the only one there, as at zero load). Its point at
+    /// τ = 1 solves the problem at `alpha` (to W's rounding in double), in the caller's
+    /// units. Err: why it did not get there.
+    fn ray_from_open(&mut self, alpha: f64) -> std::result::Result<Vec<f64>, String> {
+        let p = self.problem.p();
+        let (q, _) = self
+            .load
+            .q(alpha, self.problem.delassus())
+            .map_err(|e| e.to_string())?;
+        let g = self.problem.gap_equilibrated().to_vec();
+        let s = inf_norm(&q).max(inf_norm(&g));
+        let s = if s > 0.0 && s.is_finite() { s } else { 1.0 };
+        let open: Vec<f64> = (0..2 * p)
+            .map(|k| if k < p { -s + g[k].min(0.0) } else { 0.0 })
+            .collect();
+        let rise: Vec<f64> = q.iter().zip(&open).map(|(a, b)| a - b).collect();
+        let copy = crate::ProblemBuilder::condensed(self.problem.delassus().w().to_owned())
+            .friction(self.problem.friction_equilibrated().to_vec())
+            .gap(g)
+            .extended_precision(crate::ExtendedPrecision::Off)
+            .threads(self.problem.threads())
+            .build()
+            .map_err(|e| e.to_string())?;
+        let ray = Load::affine(open, rise).map_err(|e| e.to_string())?;
+        let opts = PathOptions {
+            alpha_start: 0.0,
+            alpha_end: 1.0,
+            max_alpha_step: None,
+            ..self.opts.clone()
+        };
+        let mut sub = Path::new(Arc::new(copy), ray, opts).map_err(|e| e.to_string())?;
+        match sub.start_solved(0.0, None).and_then(|_| sub.run()) {
+            Ok(EndReason::Window) => match sub.pieces().last() {
+                Some(pc) if pc.alpha_to == 1.0 => Ok(self.lam_to_user(&pc.lambda_to)),
+                Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
+                None => Err("it traced no piece".to_string()),
+            },
+            Ok(r) => Err(format!("it ended ({})", r.name())),
+            Err(e) => Err(e.to_string()),
         }
     }
 
