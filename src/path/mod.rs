@@ -1743,25 +1743,7 @@ impl Path {
     fn start_from_zero_load(&mut self, alpha: f64, failed: String) -> Result<()> {
         let f = self.load.force(alpha)?;
         let ray = Load::affine(vec![0.0; f.len()], f)?;
-        let opts = PathOptions {
-            alpha_start: 0.0,
-            alpha_end: 1.0,
-            max_alpha_step: None,
-            ..self.opts.clone()
-        };
-        let mut sub = Path::new(self.problem.clone(), ray, opts)?;
-        let end = match sub.start_solved(0.0, None).and_then(|_| sub.run()) {
-            Ok(EndReason::Window) => match sub.pieces().last() {
-                Some(pc) if pc.alpha_to == 1.0 => Ok(pc.lambda_to.clone()),
-                Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
-                None => Err("it traced no piece".to_string()),
-            },
-            Ok(r) => Err(format!("it ended ({})", r.name())),
-            // The host's load failed: its error, not the solver's.
-            Err(e @ Error::Load { .. }) => return Err(e),
-            Err(e) => Err(e.to_string()),
-        };
-        let end = match end {
+        let end = match self.ray_end(self.problem.clone(), ray)? {
             Ok(lam) => Ok(lam),
             Err(why) => self.ray_from_open(alpha).map_err(|why2| {
                 format!("{why}; the path from every node open, on W in double, did not reach it either: {why2}")
@@ -1811,22 +1793,38 @@ impl Path {
             .build()
             .map_err(|e| e.to_string())?;
         let ray = Load::affine(open, rise).map_err(|e| e.to_string())?;
+        let lam = self
+            .ray_end(Arc::new(copy), ray)
+            .map_err(|e| e.to_string())??;
+        Ok(self.lam_to_user(&lam))
+    }
+
+    /// The point at τ = 1 (forces in `problem`'s units) of the path of `problem` under
+    /// `ray` from τ = 0 to 1 (a window of its own, this path's other options; its events
+    /// are dropped), or why it did not get there. Errors: the host's load failed (its
+    /// error, not the solver's), the path cannot be made.
+    fn ray_end(
+        &self,
+        problem: Arc<Problem>,
+        ray: Load,
+    ) -> Result<std::result::Result<Vec<f64>, String>> {
         let opts = PathOptions {
             alpha_start: 0.0,
             alpha_end: 1.0,
             max_alpha_step: None,
             ..self.opts.clone()
         };
-        let mut sub = Path::new(Arc::new(copy), ray, opts).map_err(|e| e.to_string())?;
-        match sub.start_solved(0.0, None).and_then(|_| sub.run()) {
+        let mut sub = Path::new(problem, ray, opts)?;
+        Ok(match sub.start_solved(0.0, None).and_then(|_| sub.run()) {
             Ok(EndReason::Window) => match sub.pieces().last() {
-                Some(pc) if pc.alpha_to == 1.0 => Ok(self.lam_to_user(&pc.lambda_to)),
+                Some(pc) if pc.alpha_to == 1.0 => Ok(pc.lambda_to.clone()),
                 Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
                 None => Err("it traced no piece".to_string()),
             },
             Ok(r) => Err(format!("it ended ({})", r.name())),
+            Err(e @ Error::Load { .. }) => return Err(e),
             Err(e) => Err(e.to_string()),
-        }
+        })
     }
 
     /// The fixed-α solver can stall where the problem has a regular solution: on a slender
