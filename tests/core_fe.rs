@@ -324,17 +324,22 @@ fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
     }
 }
 
-/// Starts where every stage of the fixed-α solver fails, at α = 4 and at every nearby α
-/// (F = 5: a body in a corner, p = 35, and a curved foundation, p = 24, traced from 4 to
-/// −2), are reached from zero load (see `Path::start`): the start and the whole path
-/// agree with the independent tracer of `tests/common/reference.rs`, which checks that
-/// the start's piece reproduces fricont's start λ with every guard positive. Before,
-/// `Path::start` returned `SolveFailed` on both. So does a third (a corner, p = 24, every
-/// gap zero, F = 5, α = 20), where the ray from zero load cannot leave τ = 0 (every node
-/// at its vertex) and the ray from every node open reaches the start. (A sweep of 20,000 seeds of this file's
-/// families against that tracer, with reversed windows and rows scaled by 1e-6 … 1e6,
-/// found these two; every other trace agreed, three of them from another solution of a
-/// start with several, whose path agreed with the reference too.)
+/// Starts where every stage of the fixed-α solver fails, at the start's α and at every
+/// nearby α, are reached from zero load (see `Path::start`), all three with F = 5:
+/// * a body in a corner (p = 35) and a curved foundation (p = 24), from α = 4 to −2,
+///   where `Path::start` returned `SolveFailed`: the path of the load `τ f(4)` from
+///   τ = 0 reaches them;
+/// * a corner whose gaps are all zero (p = 24), from α = 20 to −2: that path cannot leave
+///   τ = 0 (every node at the vertex of its cone), and the ray from every node open
+///   reaches the start.
+///
+/// The start and the whole path must agree with the independent tracer of
+/// `tests/common/reference.rs`, which checks that the start's piece reproduces fricont's
+/// start λ with every guard positive. (Sweeps of this file's families against that tracer
+/// found them: the first two among 20,000 seeds with reversed windows and rows scaled by
+/// 1e-6 … 1e6, the third among 2,000 started at α = 20; every other trace agreed, some
+/// from another solution of a start with several, whose path agreed with the reference
+/// too.)
 #[test]
 fn starts_where_every_stage_fails_are_reached_from_zero_load() {
     let mut curved = curved_foundation(8066);
