@@ -1712,15 +1712,12 @@ impl Path {
     /// fails (also from every nearby α and from zero load), the load fails, no piece
     /// leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
-        match self.start_solved(alpha, guess) {
-            Err(Error::SolveFailed { message, .. }) => {
-                match self.start_from_nearby(alpha, message) {
-                    Err(Error::SolveFailed { message, .. }) => {
-                        self.start_from_zero_load(alpha, message)
-                    }
-                    r => r,
-                }
-            }
+        let r = match self.start_solved(alpha, guess) {
+            Err(Error::SolveFailed { message, .. }) => self.start_from_nearby(alpha, message),
+            r => r,
+        };
+        match r {
+            Err(Error::SolveFailed { message, .. }) => self.start_from_zero_load(alpha, message),
             r => r,
         }
     }
