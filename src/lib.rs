@@ -65,5 +65,7 @@ pub use error::{Error, Result};
 /// blocks of a [`HostSolve`] are faer matrices).
 pub use faer;
 pub use load::Load;
-pub use path::{EndReason, Event, Path, PathOptions, PieceRecord, Progress, Solution, StepOutcome};
+pub use path::{
+    EndReason, Event, Path, PathOptions, PieceRecord, Progress, Solution, StartRoute, StepOutcome,
+};
 pub use problem::{CsrMatrix, ExtendedPrecision, Problem, ProblemBuilder, Storage};

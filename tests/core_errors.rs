@@ -576,6 +576,7 @@ fn usage_errors() {
     )
     .unwrap();
     assert!(!path.is_started());
+    assert_eq!(path.start_route(), None);
     let e = no_panic("step before start", || path.step()).unwrap_err();
     assert!(matches!(e, Error::Usage(_)), "{e:?}");
     let e = no_panic("current before start", || path.current()).unwrap_err();
@@ -583,6 +584,8 @@ fn usage_errors() {
     assert!(no_panic("solutions_at before start", || path.solutions_at(0.0)).is_err());
     path.start(-1.0, None).unwrap();
     assert!(path.is_started());
+    // (one node: the fixed-α solver at α solves it; no fallback)
+    assert_eq!(path.start_route(), Some(fricont::StartRoute::Solved));
     let e = no_panic("choose_branch without bifurcation", || {
         path.choose_branch(0)
     })

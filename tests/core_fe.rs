@@ -282,27 +282,63 @@ fn slender_strips_against_the_reference() {
     }
 }
 
-/// A start where the fixed-α solver stalls (400 × 4 elements on 10 × 0.1, F = 5: at
-/// α = −2 every stage failed, its friction continuation at 0.875 F, and so on 1e-3 around
-/// it) is reached by the path from a nearby α. The start and the whole path must agree with
-/// the independent reference tracer (which checks that the start's piece reproduces its λ).
-/// Before the nearby starts, `Path::start` returned `SolveFailed` here. With the window's
-/// far end at 1e12 the same start and events follow (the nearby α were 1e-3 … 1e-1 of the
-/// window's length away, 1e9 and more: every one failed, and so did the start).
+/// Starts where the fixed-α solver stalls are reached by the path from a nearby α, and
+/// `start_route` says so:
+/// * 318 × 1 elements on 10 × 0.19, F = 5, from α = −2 (found by a sweep of 400 slender
+///   strips, the only one of them that needed it): the start and the whole path must
+///   agree with the independent reference tracer (which checks that the start's piece
+///   reproduces fricont's λ) to 1e-9;
+/// * 400 × 4 elements on 10 × 0.1, F = 5, from α = −2, in double: every stage failed, its
+///   friction continuation at 0.875 F, and so on 1e-3 around it. Its start must agree with
+///   the reference's to κ(W) ε, what double allows. With the window's far end at 1e12 the
+///   same start and events follow (the nearby α were 1e-3 … 1e-1 of the window's length
+///   away, 1e9 and more: every one failed, and so did the start). In extended precision
+///   (which `auto` chooses for this strip) the solver's stalled iterate is solved again on
+///   its piece in double-double, and the solver now reaches the start itself; that path
+///   agrees with the reference to 1e-9.
+///
+/// Before the nearby starts, `Path::start` returned `SolveFailed` on both.
 #[test]
 fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
+    let mut short = common::fe_strip(82, 318, 1, 5.0, 10.0, 1.906413598103785e-1);
+    (short.a0, short.a1) = (-2.0, 2.0);
+    let c = against_the_reference("seed 82, 318 × 1 elements on 10 × 0.19", &short);
+    assert!(c.fricont.len() >= 500, "{} events", c.fricont.len());
+    assert_eq!(c.fricont_route, fricont::StartRoute::Nearby);
+
     let mut case = common::fe_strip(3, 400, 4, 5.0, 10.0, 0.1);
     (case.a0, case.a1) = (-2.0, 2.0);
-    let c = against_the_reference("seed 3, 400 × 4 elements on 10 × 0.1", &case);
-    assert!(c.fricont.len() >= 100, "{} events", c.fricont.len());
+    let ctx = "seed 3, 400 × 4 elements on 10 × 0.1";
+    let auto = against_the_reference(ctx, &case);
+    assert!(auto.fricont.len() >= 100, "{} events", auto.fricont.len());
+    let double = || {
+        let b = case.data.builder();
+        Arc::new(
+            b.extended_precision(fricont::ExtendedPrecision::Off)
+                .build()
+                .unwrap(),
+        )
+    };
+    // In double the path is only as accurate as W's rounding allows (κ(W) ≈ 5.9e8 here):
+    // its start must agree with the reference's to κ ε, and its events are compared with
+    // those of the far window below, also in double.
+    let c = common::reference::compare_case(&case, double(), 1e-9);
+    assert_eq!(
+        c.fricont_route,
+        fricont::StartRoute::Nearby,
+        "{ctx}, in double"
+    );
+    let kappa_eps = double().w_condition_estimate() * f64::EPSILON;
+    assert!(
+        c.start_diff <= kappa_eps,
+        "{ctx}, in double: start λ {:e} off the reference's, κ ε = {kappa_eps:e}",
+        c.start_diff
+    );
     let load = case.data.affine_load();
-    let mut path = fricont::Path::new(
-        Arc::new(case.data.problem()),
-        load,
-        fricont::PathOptions::window(-2.0, 1e12),
-    )
-    .unwrap();
+    let mut path =
+        fricont::Path::new(double(), load, fricont::PathOptions::window(-2.0, 1e12)).unwrap();
     path.start(-2.0, None).expect("start with a far window end");
+    assert_eq!(path.start_route(), Some(fricont::StartRoute::Nearby));
     while path.events().last().is_none_or(|e| e.alpha <= 2.0) {
         if matches!(path.step().unwrap(), fricont::StepOutcome::End(_)) {
             break;
@@ -348,14 +384,16 @@ fn starts_where_every_stage_fails_are_reached_from_zero_load() {
     (far.a0, far.a1) = (20.0, -2.0);
     far.data.friction.iter_mut().for_each(|f| *f = 5.0);
     assert!(far.data.gap.iter().all(|&g| g == 0.0));
-    for (ctx, case) in [
-        ("corner seed 11939", in_a_corner(11939)),
-        ("curved foundation seed 8066, reversed", curved),
-        ("corner seed 40225, from alpha = 20", far),
+    use fricont::StartRoute::{Open, ZeroLoad};
+    for (ctx, case, route) in [
+        ("corner seed 11939", in_a_corner(11939), ZeroLoad),
+        ("curved foundation seed 8066, reversed", curved, ZeroLoad),
+        ("corner seed 40225, from alpha = 20", far, Open),
     ] {
         assert!(case.a0 >= 4.0 && case.data.friction[0] == 5.0, "{ctx}");
         let c = against_the_reference(ctx, &case);
         assert!(c.fricont.len() >= 5, "{ctx}: {} events", c.fricont.len());
+        assert_eq!(c.fricont_route, route, "{ctx}");
     }
 }
 

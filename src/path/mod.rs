@@ -110,6 +110,37 @@ impl EndReason {
     }
 }
 
+/// How [`Path::start`] reached the start point. Whichever it was, the start point is a
+/// solution of the problem at the start's α, checked the same way (to 1e-12 relative);
+/// the route says how hard it was to find, and, where the problem has several solutions
+/// there (large friction, a path that folds back over α), which search picked this one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StartRoute {
+    /// The fixed-α solver at α, from the guess or from zero forces.
+    Solved,
+    /// The solver failed at α; a path traced from a nearby α reached it.
+    Nearby,
+    /// The solver failed at α and near it; the path of the load `τ f(α)` from zero load
+    /// (τ = 0) reached it at τ = 1.
+    ZeroLoad,
+    /// As [`StartRoute::ZeroLoad`], but that ray could not leave τ = 0 (every gap zero);
+    /// the ray from a load that holds every node open reached it.
+    Open,
+}
+
+impl StartRoute {
+    /// Its name in the bindings (Python, MATLAB): `"solved"`, `"nearby"`, `"zero_load"`,
+    /// `"open"`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            StartRoute::Solved => "solved",
+            StartRoute::Nearby => "nearby",
+            StartRoute::ZeroLoad => "zero_load",
+            StartRoute::Open => "open",
+        }
+    }
+}
+
 /// A point of the solution curve with everything a user reads.
 #[derive(Debug, Clone, PartialEq)]
 pub struct State {
@@ -279,6 +310,8 @@ pub struct Path {
 /// The traced data and the current position.
 struct Trace {
     start: StartPoint,
+    /// How the start point was reached.
+    route: StartRoute,
     events: Vec<Event>,
     pieces: Vec<PieceRecord>,
     cur: CurrentPiece,
@@ -1707,19 +1740,26 @@ impl Path {
     /// gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1 is the start; where
     /// that path does not get there (it cannot leave τ = 0 where every gap is zero), the
     /// same ray from a load that holds every node open at τ = 0 (on the equilibrated W
-    /// in double; its point at τ = 1 is the start's guess).
+    /// in double; its point at τ = 1 is the start's guess). [`Path::start_route`] says
+    /// which of these reached the start.
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails (also from every nearby α and from zero load), the load fails, no piece
     /// leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
         let r = match self.start_solved(alpha, guess) {
-            Err(Error::SolveFailed { message, .. }) => self.start_from_nearby(alpha, message),
-            r => r,
+            Err(Error::SolveFailed { message, .. }) => self
+                .start_from_nearby(alpha, message)
+                .map(|()| StartRoute::Nearby),
+            r => r.map(|()| StartRoute::Solved),
         };
-        match r {
-            Err(Error::SolveFailed { message, .. }) => self.start_from_zero_load(alpha, message),
-            r => r,
+        let route = match r {
+            Err(Error::SolveFailed { message, .. }) => self.start_from_zero_load(alpha, message)?,
+            r => r?,
+        };
+        if let Some(tr) = self.trace.as_mut() {
+            tr.route = route;
         }
+        Ok(())
     }
 
     /// The fixed-α solver can fail where the path from nearby α fails as well: on a body
@@ -1736,18 +1776,21 @@ impl Path {
     /// path of its own (an affine load `0 + τ f(alpha)`, window [0, 1], this path's other
     /// options); its events are dropped. Where it does not reach τ = 1, the ray from every
     /// node open ([`Self::ray_from_open`]); where neither does: `SolveFailed` with `failed`
-    /// and where each ended.
-    fn start_from_zero_load(&mut self, alpha: f64, failed: String) -> Result<()> {
+    /// and where each ended. Ok: which ray reached the start.
+    fn start_from_zero_load(&mut self, alpha: f64, failed: String) -> Result<StartRoute> {
         let f = self.load.force(alpha)?;
         let ray = Load::affine(vec![0.0; f.len()], f)?;
         let end = match self.ray_end(self.problem.clone(), ray)? {
-            Ok(lam) => Ok(lam),
-            Err(why) => self.ray_from_open(alpha).map_err(|why2| {
-                format!("{why}; the path from every node open, on W in double, did not reach it either: {why2}")
-            }),
+            Ok(lam) => Ok((lam, StartRoute::ZeroLoad)),
+            Err(why) => match self.ray_from_open(alpha) {
+                Ok(lam) => Ok((lam, StartRoute::Open)),
+                Err(why2) => Err(format!(
+                    "{why}; the path from every node open, on W in double, did not reach it either: {why2}"
+                )),
+            },
         };
         match end {
-            Ok(lam) => self.start_solved(alpha, Some(&lam)),
+            Ok((lam, route)) => self.start_solved(alpha, Some(&lam)).map(|()| route),
             Err(why) => Err(Error::SolveFailed {
                 alpha,
                 message: format!(
@@ -1936,6 +1979,13 @@ impl Path {
             self.start_on_its_piece(&iterate, &qg, ITERATE_REFINE_ROUNDS)
                 .map(|(lam, _)| lam)
         };
+        #[cfg(test)]
+        if guess.is_none() && tests::REFUSE_START_AT.get() == Some(alpha) {
+            return Err(Error::SolveFailed {
+                alpha,
+                message: "refused by the test switch".to_string(),
+            });
+        }
         let lam = solve_fixed_alpha(&problem, &qg, guess.as_deref(), alpha, Some(&mut polish))?;
         let mut pt = Point { lam, ..pt };
         let mut tol = self.tol_at(&pt);
@@ -2223,6 +2273,7 @@ impl Path {
         };
         self.trace = Some(Trace {
             start,
+            route: StartRoute::Solved,
             events: Vec::new(),
             event_loads: Vec::new(),
             pieces: vec![piece],
@@ -2386,6 +2437,68 @@ impl Path {
                     }
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{CsrMatrix, ProblemBuilder, Storage};
+
+    thread_local! {
+        /// Test switch: the fixed-α solver fails at this α when started without a guess,
+        /// as where every stage stalls at the start's α but not near it.
+        pub(super) static REFUSE_START_AT: std::cell::Cell<Option<f64>> =
+            const { std::cell::Cell::new(None) };
+    }
+
+    /// The block on a foundation, solved by hand: A = diag(2, 1), N = [1, 0], T = [0, 1],
+    /// F = 1/2, f(α) = (1, 0) + α (0, 1). At α = 0 the node sticks with λ = (−1, 0); it
+    /// slips in +t from α = 1/2 (λt reaches F λν = −1/2). Where the solver fails at the
+    /// start's α, the start comes from a nearby α, and says so; the same start and event.
+    #[test]
+    fn a_start_the_solver_misses_comes_from_a_nearby_alpha_and_says_so() {
+        let csr = |r, c, v: &[f64]| CsrMatrix::from_dense(r, c, v).unwrap();
+        let problem = Arc::new(
+            ProblemBuilder::new(
+                csr(2, 2, &[2.0, 0.0, 0.0, 1.0]),
+                Storage::Full,
+                csr(1, 2, &[1.0, 0.0]),
+                csr(1, 2, &[0.0, 1.0]),
+            )
+            .friction_uniform(0.5)
+            .build()
+            .unwrap(),
+        );
+        for (refuse, route) in [(None, StartRoute::Solved), (Some(0.0), StartRoute::Nearby)] {
+            let load = Load::affine(vec![1.0, 0.0], vec![0.0, 1.0]).unwrap();
+            let mut path = Path::new(problem.clone(), load, PathOptions::window(0.0, 2.0)).unwrap();
+            REFUSE_START_AT.set(refuse);
+            let started = path.start(0.0, None);
+            REFUSE_START_AT.set(None);
+            started.unwrap();
+            assert_eq!(path.start_route(), Some(route));
+            let st = path.start_state().unwrap();
+            assert!(
+                st.alpha == 0.0 && st.classes == [Class::Stick],
+                "{route:?}: {st:?}"
+            );
+            assert!(
+                (st.lambda_n[0] + 1.0).abs() <= 1e-15 && st.lambda_t[0].abs() <= 1e-15,
+                "{route:?}: λ = ({}, {})",
+                st.lambda_n[0],
+                st.lambda_t[0]
+            );
+            assert_eq!(path.run().unwrap(), EndReason::Window);
+            let ev = path.events();
+            assert_eq!(ev.len(), 1, "{route:?}");
+            assert!(
+                (ev[0].alpha - 0.5).abs() <= 1e-15,
+                "{route:?}: α = {}",
+                ev[0].alpha
+            );
+            assert_eq!((ev[0].from, ev[0].to), (Class::Stick, Class::SlipPlus));
         }
     }
 }

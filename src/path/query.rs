@@ -23,6 +23,12 @@ impl Path {
         self.trace.as_ref().and_then(|t| t.end.as_ref())
     }
 
+    /// How [`Path::start`] reached the start point: the fixed-α solver, or one of its
+    /// fallbacks where the solver failed (see [`StartRoute`]). None before the start.
+    pub fn start_route(&self) -> Option<StartRoute> {
+        self.trace.as_ref().map(|t| t.route)
+    }
+
     /// The full state at the start point: u = A⁻¹ (f(α) + Bᵀλ) and the residual,
     /// computed on request as an event's is ([`Path::event_state`]: with fricont's own
     /// factor and an affine or basis load, by the backward half of a solve only), so a

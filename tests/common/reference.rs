@@ -1297,6 +1297,8 @@ pub struct Comparison {
     pub fricont: Vec<Ev>,
     /// fricont's end: (α at the end of its last piece, reason).
     pub fricont_end: (f64, String),
+    /// How fricont's start was reached (`Path::start_route`).
+    pub fricont_route: fricont::StartRoute,
     /// The reference trace.
     pub reference: RefTrace,
     /// max |λ_fricont − λ_ref| / max |λ| at the start.
@@ -1475,6 +1477,7 @@ pub fn compare_with_fricont(
     let mut path =
         fricont::Path::new(problem, load, fricont::PathOptions::window(a0, a1)).expect("Path::new");
     path.start(a0, None).expect("fricont start");
+    let route = path.start_route().expect("started");
     let run = path.run();
     let fr_secs = t.elapsed().as_secs_f64();
     let fricont: Vec<Ev> = path
@@ -1548,6 +1551,7 @@ pub fn compare_with_fricont(
         folds,
         fricont,
         fricont_end: (end_alpha, reason),
+        fricont_route: route,
         reference,
         start_diff,
         end_diff,
