@@ -484,6 +484,9 @@ int main(int argc, char **argv) {
     int32_t reason = -1;
     fricont_path_end_reason(path, &reason);
     CHECK(reason == FRICONT_END_WINDOW, "end reason %d", reason);
+    int32_t route = -1;
+    CHECK(fricont_path_start_route(path, &route) == FRICONT_OK && route == FRICONT_START_SOLVED,
+          "start route %d (the fixed-alpha solver starts every case this test traces)", route);
     int64_t ne = 0, np = 0;
     fricont_path_event_count(path, &ne);
     fricont_path_piece_count(path, &np);

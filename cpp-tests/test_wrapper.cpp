@@ -212,6 +212,8 @@ int main(int argc, char **argv) {
     fricont::EndReason why = path.run();
     std::vector<fricont::Event> ev = path.events();
     report("affine: ends at the window", why == fricont::EndReason::Window, fricont::name(why));
+    report("affine: the fixed-alpha solver found the start",
+           path.start_route() == fricont::StartRoute::Solved, fricont::name(path.start_route()));
     std::string diff = compare(ev, ref, 0.0, same, ref.size());
     report("affine: events equal the C reference", diff.empty() && ev.size() == ref.size(), diff);
     report("affine: pieces = events + 1", path.pieces().size() == ev.size() + 1);
@@ -393,6 +395,13 @@ int main(int argc, char **argv) {
             status = e.status();
         }
         report("start without window throws FRICONT_ERR_ORDER", status == FRICONT_ERR_ORDER);
+        status = 0;
+        try {
+            q.start_route();
+        } catch (const fricont::Error &e) {
+            status = e.status();
+        }
+        report("start_route before the start throws FRICONT_ERR_ORDER", status == FRICONT_ERR_ORDER);
         status = 0;
         try {
             prob.set_friction(-1.0);

@@ -80,13 +80,19 @@ module fricont
     integer, parameter, public :: FRICONT_END_BIFURCATION = 4
     integer, parameter, public :: FRICONT_END_FAILED = 5
     integer, parameter, public :: FRICONT_END_STOPPED = 6
+    ! ---- How the start was reached (fricont_start_route) ----------------------------------
+    integer, parameter, public :: FRICONT_START_SOLVED = 0
+    integer, parameter, public :: FRICONT_START_NEARBY = 1
+    integer, parameter, public :: FRICONT_START_ZERO_LOAD = 2
+    integer, parameter, public :: FRICONT_START_OPEN = 3
     ! ---- Extended precision modes (fricont_problem_set_extended_precision) ---------------
     integer, parameter, public :: FRICONT_EXTENDED_AUTO = 0
     integer, parameter, public :: FRICONT_EXTENDED_ON = 1
     integer, parameter, public :: FRICONT_EXTENDED_OFF = 2
 
     public :: fricont_load_fn, fricont_weights_fn, fricont_solve_fn, fricont_monitor_fn
-    public :: fricont_class_name, fricont_end_reason_name, fricont_status_name, fricont_version
+    public :: fricont_class_name, fricont_end_reason_name, fricont_start_route_name
+    public :: fricont_status_name, fricont_version
 
     !> The error argument: `status` (a negative fricont_status, or FRICONT_OK) and the
     !> library's message.
@@ -180,6 +186,7 @@ module fricont
         procedure :: step => path_step
         procedure :: run => path_run
         procedure :: end_reason => path_end_reason
+        procedure :: start_route => path_start_route
         procedure :: callback_code => path_callback_code
         procedure :: event_count => path_event_count
         procedure :: event => path_event
@@ -466,6 +473,12 @@ module fricont
             integer(c_int32_t), intent(out) :: r
             integer(c_int32_t) :: c_path_end_reason
         end function
+        function c_path_start_route(h, r) bind(C, name="fricont_path_start_route")
+            import :: c_ptr, c_int32_t
+            type(c_ptr), value :: h
+            integer(c_int32_t), intent(out) :: r
+            integer(c_int32_t) :: c_path_start_route
+        end function
         function c_path_callback_code(h, c) bind(C, name="fricont_path_callback_code")
             import :: c_ptr, c_int32_t
             type(c_ptr), value :: h
@@ -698,6 +711,19 @@ contains
         case default; s = 'unknown'
         end select
     end function fricont_end_reason_name
+
+    !> Name of a start route: "solved", "nearby", "zero_load", "open".
+    function fricont_start_route_name(code) result(s)
+        integer, intent(in) :: code
+        character(len=:), allocatable :: s
+        select case (code)
+        case (FRICONT_START_SOLVED); s = 'solved'
+        case (FRICONT_START_NEARBY); s = 'nearby'
+        case (FRICONT_START_ZERO_LOAD); s = 'zero_load'
+        case (FRICONT_START_OPEN); s = 'open'
+        case default; s = 'unknown'
+        end select
+    end function fricont_start_route_name
 
     !> Description of a status code ("FRICONT_ERR_CSR: ...").
     function fricont_status_name(st) result(s)
@@ -1236,6 +1262,19 @@ contains
         call handle(c_path_end_reason(self%h, r), err, 'fricont_path%end_reason')
         path_end_reason = r
     end function path_end_reason
+
+    !> How the start point was reached: FRICONT_START_SOLVED where the fixed-alpha solver
+    !> found it, another FRICONT_START_* code where one of its fallbacks did (see
+    !> fricont_path_start in fricont.h). Before the start: error FRICONT_ERR_ORDER (with
+    !> err present the result is -1; without it the program stops).
+    integer function path_start_route(self, err)
+        class(fricont_path), intent(in) :: self
+        type(fricont_error), intent(out), optional :: err
+        integer(c_int32_t) :: r
+        r = -1
+        call handle(c_path_start_route(self%h, r), err, 'fricont_path%start_route')
+        path_start_route = r
+    end function path_start_route
 
     !> The nonzero code the last failing load callback returned (0 if none).
     integer function path_callback_code(self, err)

@@ -331,6 +331,44 @@ typedef int32_t fricont_end_reason;
 #endif // __cplusplus
 
 /**
+ * How `fricont_path_start` reached the start point (`fricont_path_start_route`). Every
+ * route ends in the same check: the start point solves the problem at the start's α to
+ * 1e-12 relative. Where the problem has several solutions there (large friction, a path
+ * that folds back over α), the route says which search picked this one.
+ */
+enum fricont_start_route
+#if defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+  : int32_t
+#endif // defined(__cplusplus) || __STDC_VERSION__ >= 202311L
+ {
+    /**
+     * The fixed-α solver at α, from the guess or from zero forces.
+     */
+    FRICONT_START_SOLVED = 0,
+    /**
+     * The solver failed at α; a path traced from a nearby α reached it.
+     */
+    FRICONT_START_NEARBY = 1,
+    /**
+     * The solver failed at α and near it; the path of the load `tau f(alpha)` from zero
+     * load (tau = 0) reached it at tau = 1.
+     */
+    FRICONT_START_ZERO_LOAD = 2,
+    /**
+     * As `FRICONT_START_ZERO_LOAD`, but that path could not leave tau = 0 (every gap
+     * zero); the path from a load that holds every node open reached it.
+     */
+    FRICONT_START_OPEN = 3,
+};
+#ifndef __cplusplus
+#if __STDC_VERSION__ >= 202311L
+typedef enum fricont_start_route fricont_start_route;
+#else
+typedef int32_t fricont_start_route;
+#endif // __STDC_VERSION__ >= 202311L
+#endif // __cplusplus
+
+/**
  * A path: a load bound to a problem, traced step by step. Opaque.
  *
  * Created by `fricont_path_new_affine`, `_basis` or `_general`, configured by the
@@ -1358,7 +1396,8 @@ fricont_status fricont_path_set_monitor(struct fricont_path *path,
  * through its folds, and its point at τ = 1 is the start; where that path cannot leave
  * τ = 0 (every gap zero: every node at the vertex of its cone), the same ray from a load
  * that holds every node open (`FRICONT_ERR_SOLVE_FAILED` only where that fails too; the
- * message says what each attempt reached).
+ * message says what each attempt reached). `fricont_path_start_route` says which of these
+ * reached the start.
  *
  * The problem at one α can have several solutions (large friction, a path that folds
  * back over `alpha`); the solver returns one of them, and which one can depend on
@@ -1428,6 +1467,21 @@ fricont_status fricont_path_run(struct fricont_path *path);
  */
 fricont_status fricont_path_end_reason(const struct fricont_path *path,
                                        int32_t *reason);
+
+/**
+ * How `fricont_path_start` reached the start point: `*route` receives a
+ * `fricont_start_route` code (`FRICONT_START_SOLVED` where the fixed-α solver found it,
+ * another code where one of its fallbacks did; see `fricont_path_start`). `route` must
+ * not be NULL.
+ *
+ * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
+ * `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+ *
+ * # Safety
+ * `path` is NULL or a live handle; `route` is NULL or valid for one write.
+ */
+fricont_status fricont_path_start_route(const struct fricont_path *path,
+                                        int32_t *route);
 
 /**
  * The nonzero code returned by the most recent failing load callback on this path

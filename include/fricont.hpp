@@ -108,6 +108,26 @@ inline std::string name(EndReason r) {
     return "unknown";
 }
 
+/// How `Path::start` reached the start point (`Path::start_route`): the fixed-α solver,
+/// or one of its fallbacks where the solver failed (see `fricont_path_start`).
+enum class StartRoute : int32_t {
+    Solved = FRICONT_START_SOLVED,
+    Nearby = FRICONT_START_NEARBY,
+    ZeroLoad = FRICONT_START_ZERO_LOAD,
+    Open = FRICONT_START_OPEN,
+};
+
+/// "solved", "nearby", "zero_load" or "open".
+inline std::string name(StartRoute r) {
+    switch (r) {
+    case StartRoute::Solved: return "solved";
+    case StartRoute::Nearby: return "nearby";
+    case StartRoute::ZeroLoad: return "zero_load";
+    case StartRoute::Open: return "open";
+    }
+    return "unknown";
+}
+
 /// The library's run-time version "MAJOR.MINOR.PATCH".
 inline std::string version() { return fricont_version(); }
 
@@ -615,6 +635,13 @@ public:
         int32_t r = 0;
         check(fricont_path_end_reason(h_, &r));
         return static_cast<EndReason>(r);
+    }
+    /// How the start point was reached (`StartRoute::Solved` unless a fallback of the
+    /// fixed-α solver found it). Throws `fricont::Error` (`FRICONT_ERR_ORDER`) before the start.
+    StartRoute start_route() const {
+        int32_t r = 0;
+        check(fricont_path_start_route(h_, &r));
+        return static_cast<StartRoute>(r);
     }
     /// The code of the last failing load callback (0 if none).
     int32_t callback_code() const {

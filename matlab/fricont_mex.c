@@ -485,6 +485,11 @@ static const char *end_reason_name(int32_t r) {
     return r >= 0 && r <= 6 ? names[r] : "unknown";
 }
 
+static const char *start_route_name(int32_t r) {
+    static const char *names[] = {"solved", "nearby", "zero_load", "open"};
+    return r >= 0 && r <= 3 ? names[r] : "unknown";
+}
+
 /* ---- Commands -------------------------------------------------------------------- */
 
 #define NEED(k)                                                                        \
@@ -890,17 +895,19 @@ static void cmd_path_result(mxArray *plhs[], int nrhs, const mxArray *prhs[], co
     check(fricont_path_start_state(path, &b.st), "start state");
     set_state_fields(start, 0, &b, n, p);
 
-    int32_t reason = 0, code = 0;
+    int32_t reason = 0, code = 0, route = 0;
     check(fricont_path_end_reason(path, &reason), "end reason");
     check(fricont_path_callback_code(path, &code), "callback code");
+    check(fricont_path_start_route(path, &route), "start route");
     static const char *fields[] = {"events", "pieces", "start", "end_reason", "n", "p",
-                                   "callback_code", "branches"};
-    mxArray *out = mxCreateStructMatrix(1, 1, 8, fields);
+                                   "callback_code", "branches", "start_route"};
+    mxArray *out = mxCreateStructMatrix(1, 1, 9, fields);
     mxSetField(out, 0, "branches", branch_array(path, p, b.cls));
     mxSetField(out, 0, "events", events);
     mxSetField(out, 0, "pieces", pcs);
     mxSetField(out, 0, "start", start);
     mxSetField(out, 0, "end_reason", mxCreateString(end_reason_name(reason)));
+    mxSetField(out, 0, "start_route", mxCreateString(start_route_name(route)));
     mxSetField(out, 0, "n", mxCreateDoubleScalar((double)n));
     mxSetField(out, 0, "p", mxCreateDoubleScalar((double)p));
     mxSetField(out, 0, "callback_code", mxCreateDoubleScalar((double)code));

@@ -393,6 +393,21 @@ fn trace(args: &TraceArgs) -> Result<(), Failure> {
     let t1 = Instant::now();
     path.start(alpha_start, None)
         .map_err(|e| runtime(format!("start at alpha = {alpha_start}: {e}")))?;
+    // Where the solver failed and a fallback found the start: say which (where the
+    // problem has several solutions at alpha_start, that decides which one is traced).
+    let how = match path.start_route() {
+        Some(fricont::StartRoute::Nearby) => Some("the path from a nearby alpha"),
+        Some(fricont::StartRoute::ZeroLoad) => {
+            Some("the path of tau f(alpha_start) from zero load (tau = 0 to 1)")
+        }
+        Some(fricont::StartRoute::Open) => Some("the path from a load that holds every node open"),
+        Some(fricont::StartRoute::Solved) | None => None,
+    };
+    if let Some(how) = how {
+        eprintln!(
+            "fricont: note: the fixed-alpha solver failed at alpha = {alpha_start}; the start was reached by {how}"
+        );
+    }
     let offered = path.branches().len();
     let start_branch = args.start_branch.unwrap_or(1);
     if start_branch as usize > offered.max(1) {

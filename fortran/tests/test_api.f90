@@ -236,6 +236,9 @@ contains
         ev = path%events()
         call check('affine: ends at the window', reason == FRICONT_END_WINDOW)
         call check('affine: events found', size(ev) >= 2)
+        call check('affine: the fixed-alpha solver found the start', &
+                   path%start_route() == FRICONT_START_SOLVED, &
+                   fricont_start_route_name(path%start_route()))
 
         block
             type(fricont_path) :: p0

@@ -14,6 +14,8 @@ function failures = test_fricont(case_dir, out_dir)
   res = fricont_trace(c.A, c.N, c.T, c.f0, c.f1, c.F, win, opts);
   write_events(fullfile(out_dir, 'affine.txt'), res, @(a) a);
   failures = failures + check('affine: ends at the window', strcmp(res.end_reason, 'window'));
+  failures = failures + check('affine: the fixed-alpha solver found the start', ...
+                              strcmp(res.start_route, 'solved'));
   failures = failures + check('affine: pieces = events + 1', numel(res.pieces) == numel(res.events) + 1);
   failures = failures + check('handle locks the MEX file', fricont_mex('is_locked'));
   ev = res.events;

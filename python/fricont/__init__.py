@@ -250,6 +250,12 @@ class Path:
         self.end_reason: str = reason if reason is not None else "none"
         #: The failure message when ``end_reason == "failed"``.
         self.end_message: Optional[str] = message
+        #: How the start point was reached: "solved" (the fixed-alpha solver at the
+        #: start's alpha), or where it failed, "nearby" (a path traced from a nearby
+        #: alpha), "zero_load" (the path of the load tau f(alpha) from tau = 0) or "open"
+        #: (the path from a load that holds every node open); "none" when the path never
+        #: started. Every route ends in the same check of the start point.
+        self.start_route: str = core.start_route() or "none"
         #: The candidate continuations (:class:`Branch`) at the last transition point,
         #: 0-based as ``choose_branch`` takes them: empty unless it was a bifurcation
         #: and the path has not moved on since (where it stopped there: ``end_reason ==

@@ -62,6 +62,7 @@ class Path:
     pieces: list[Piece]
     end_reason: str
     end_message: Optional[str]
+    start_route: str
     branches: list[Branch]
     start_branches: list[Branch]
     @property

@@ -711,6 +711,12 @@ impl Path {
         })
     }
 
+    /// How the start point was reached ("solved", "nearby", "zero_load", "open"; see
+    /// `fricont::StartRoute`), or None when the path never started (the start failed).
+    fn start_route(&self, py: Python<'_>) -> PyResult<Option<&'static str>> {
+        Ok(self.lock(py)?.start_route().map(|r| r.name()))
+    }
+
     /// The start state (alpha, lambda_n, lambda_t, classes, residual; no u), None before
     /// start(). The residual takes one back-solve (with the GIL released).
     fn start_state<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {

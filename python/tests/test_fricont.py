@@ -67,6 +67,7 @@ def test_one_node_sticks_then_slips_at_the_hand_derived_alpha():
     prob = fricont.Problem(A, [[1.0, 0.0]], [[0.0, 1.0]], friction=0.5)
     path = prob.trace(f0=[1.0, 0.0], f1=[0.0, 1.0], window=(0.0, 2.0))
     assert len(path.events) == 1 and path.end_reason == "window"
+    assert path.start_route == "solved"
     e = path.events[0]
     assert (e.node, e.from_class, e.to_class) == (0, "stick", "slip+")
     assert abs(e.alpha - 0.5) <= 1e-14

@@ -9,9 +9,9 @@ use super::boundary::{
     slice_out, write_message,
 };
 use super::problem::fricont_problem;
-use super::status::{class_code, fricont_end_reason, fricont_status};
+use super::status::{class_code, fricont_end_reason, fricont_start_route, fricont_status};
 use crate::load::{Load, LoadFailure};
-use crate::path::{EndReason, Path, PathOptions, Solution, State, StepOutcome};
+use crate::path::{EndReason, Path, PathOptions, Solution, StartRoute, State, StepOutcome};
 use crate::problem::Problem;
 
 /// A general load callback: writes `f(α)` (or its derivative `f'(α)` when registered as
@@ -819,7 +819,8 @@ pub unsafe extern "C" fn fricont_path_set_monitor(
 /// through its folds, and its point at τ = 1 is the start; where that path cannot leave
 /// τ = 0 (every gap zero: every node at the vertex of its cone), the same ray from a load
 /// that holds every node open (`FRICONT_ERR_SOLVE_FAILED` only where that fails too; the
-/// message says what each attempt reached).
+/// message says what each attempt reached). `fricont_path_start_route` says which of these
+/// reached the start.
 ///
 /// The problem at one α can have several solutions (large friction, a path that folds
 /// back over `alpha`); the solver returns one of them, and which one can depend on
@@ -1006,6 +1007,41 @@ pub unsafe extern "C" fn fricont_path_end_reason(
         };
         // SAFETY: non-NULL and valid by contract.
         unsafe { reason.write(code as i32) };
+        Ok(fricont_status::FRICONT_OK)
+    })
+}
+
+/// How `fricont_path_start` reached the start point: `*route` receives a
+/// `fricont_start_route` code (`FRICONT_START_SOLVED` where the fixed-α solver found it,
+/// another code where one of its fallbacks did; see `fricont_path_start`). `route` must
+/// not be NULL.
+///
+/// Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_ORDER` (not started),
+/// `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.
+///
+/// # Safety
+/// `path` is NULL or a live handle; `route` is NULL or valid for one write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn fricont_path_start_route(
+    path: *const fricont_path,
+    route: *mut i32,
+) -> fricont_status {
+    ffi_boundary!(path => {
+        // SAFETY: NULL or a live handle, by contract.
+        let h = unsafe { handle_ref(path, "path") }?;
+        let h = h.read()?;
+        if route.is_null() {
+            return Err(Failure::null("route"));
+        }
+        let code = match h.started()?.start_route() {
+            Some(StartRoute::Solved) => fricont_start_route::FRICONT_START_SOLVED,
+            Some(StartRoute::Nearby) => fricont_start_route::FRICONT_START_NEARBY,
+            Some(StartRoute::ZeroLoad) => fricont_start_route::FRICONT_START_ZERO_LOAD,
+            Some(StartRoute::Open) => fricont_start_route::FRICONT_START_OPEN,
+            None => return Err(Failure::order(NOT_STARTED)),
+        };
+        // SAFETY: non-NULL and valid by contract.
+        unsafe { route.write(code as i32) };
         Ok(fricont_status::FRICONT_OK)
     })
 }

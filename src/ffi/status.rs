@@ -255,6 +255,26 @@ pub enum fricont_end_reason {
     FRICONT_END_STOPPED = 6,
 }
 
+/// How `fricont_path_start` reached the start point (`fricont_path_start_route`). Every
+/// route ends in the same check: the start point solves the problem at the start's α to
+/// 1e-12 relative. Where the problem has several solutions there (large friction, a path
+/// that folds back over α), the route says which search picked this one.
+#[repr(i32)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(non_camel_case_types)]
+pub enum fricont_start_route {
+    /// The fixed-α solver at α, from the guess or from zero forces.
+    FRICONT_START_SOLVED = 0,
+    /// The solver failed at α; a path traced from a nearby α reached it.
+    FRICONT_START_NEARBY = 1,
+    /// The solver failed at α and near it; the path of the load `tau f(alpha)` from zero
+    /// load (tau = 0) reached it at tau = 1.
+    FRICONT_START_ZERO_LOAD = 2,
+    /// As `FRICONT_START_ZERO_LOAD`, but that path could not leave tau = 0 (every gap
+    /// zero); the path from a load that holds every node open reached it.
+    FRICONT_START_OPEN = 3,
+}
+
 /// A static, NUL-terminated description of a status code: the enumerator's name, a colon
 /// and one line (e.g. `"FRICONT_ERR_NULL: a required pointer argument is NULL"`).
 ///

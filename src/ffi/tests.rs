@@ -159,6 +159,12 @@ fn block_on_a_foundation_matches_the_hand_solution() {
         fricont_status::FRICONT_ERR_ORDER,
         "no window yet"
     );
+    let mut route = -1;
+    assert_eq!(
+        unsafe { fricont_path_start_route(path, &mut route) },
+        fricont_status::FRICONT_ERR_ORDER,
+        "not started"
+    );
     assert_eq!(
         unsafe { fricont_path_set_window(path, 0.0, 2.0) },
         fricont_status::FRICONT_OK
@@ -192,6 +198,16 @@ fn block_on_a_foundation_matches_the_hand_solution() {
     assert!(close(ln[0], -1.0) && close(lt[0], 0.0), "{ln:?} {lt:?}");
     assert!(close(u[0], 0.0) && close(u[1], 0.0), "{u:?}");
     assert_eq!(cl[0], fricont_class::FRICONT_STICK as i32);
+    // (the solver's start: the one node pressed, λν = −1, no fallback)
+    assert_eq!(
+        unsafe { fricont_path_start_route(path, &mut route) },
+        fricont_status::FRICONT_OK
+    );
+    assert_eq!(route, fricont_start_route::FRICONT_START_SOLVED as i32);
+    assert_eq!(
+        unsafe { fricont_path_start_route(path, null_mut()) },
+        fricont_status::FRICONT_ERR_NULL
+    );
 
     let st = unsafe { fricont_path_run(path) };
     assert_eq!(st, fricont_status::FRICONT_END);
