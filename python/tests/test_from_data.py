@@ -241,6 +241,8 @@ def test_a_start_that_no_double_iterate_reaches_holds_from_the_data(tmp_path):
     assert prob.extended_precision
     for window in [(-2.0, 2.0), (-1.6, -2.0)]:
         path = prob.trace(case["f0"], case["f1"], window=window, max_steps=15)
+        # (the solver's own start, not one of its fallbacks: that is what this tests)
+        assert path.start_route == "solved", f"{window}: start route {path.start_route}"
         assert path.pieces[0].alpha_from == window[0]
         assert (path.pieces[-1].alpha_to - window[0]) * (window[1] - window[0]) > 0
         assert_valid(case, path, lambda a: a, end="max_steps", ctx=f"{window}: ")
