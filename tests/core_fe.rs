@@ -397,6 +397,55 @@ fn starts_where_every_stage_fails_are_reached_from_zero_load() {
     }
 }
 
+/// A strip that rounding derails in double (`fe_strip` seed 1597, 85 × 4 elements on
+/// 10 × 0.07, F = 1, from α = 2 to −2, κ(W) = 1.0e8; `auto` carries it in extended
+/// precision, where its path agrees with the reference, 428 events). In double the path
+/// may fail, but it must not claim what it has not traced: a join where the usual
+/// thresholds found no continuation took the first widening that found several, and the
+/// path ended as a closed loop at α = 0.025 after 268 events, while the reference's goes
+/// on to −2. (Found by a sweep of 2,000 traces of this file's families, half of them in
+/// double, the only one that reached that branch.) It must now reach the window's end,
+/// with the reference's events to what double allows (50 κ(W) ε), or return an error.
+#[test]
+fn a_strip_derailed_by_rounding_in_double_fails_instead_of_closing_a_loop() {
+    let mut case = common::fe_strip(1597, 85, 4, 1.0, 10.0, 6.988920417062604e-2);
+    (case.a0, case.a1) = (2.0, -2.0);
+    let ctx = "seed 1597, 85 × 4 elements on 10 × 0.07";
+    let exact = against_the_reference(ctx, &case);
+    let b = case.data.builder();
+    let problem = b
+        .extended_precision(fricont::ExtendedPrecision::Off)
+        .build()
+        .unwrap();
+    let tol = 50.0 * problem.w_condition_estimate() * f64::EPSILON;
+    let mut path = fricont::Path::new(
+        Arc::new(problem),
+        case.data.affine_load(),
+        fricont::PathOptions::window(2.0, -2.0),
+    )
+    .unwrap();
+    path.start(2.0, None).expect("start");
+    match path.run() {
+        Err(_) => {}
+        Ok(EndReason::Window) => {
+            let got: Vec<common::reference::Ev> = path
+                .events()
+                .iter()
+                .map(|e| (e.alpha, e.node, e.from, e.to))
+                .collect();
+            let want: Vec<common::reference::Ev> = exact.fricont.clone();
+            common::reference::compare_events(&got, &want, tol)
+                .unwrap_or_else(|e| panic!("{ctx}, in double: {e}"));
+        }
+        Ok(r) => panic!(
+            "{ctx}, in double: ended ({}) at α = {:?} after {} events",
+            r.name(),
+            path.pieces().last().map(|p| p.alpha_to),
+            path.events().len()
+        ),
+    }
+}
+
 /// `case` traced by fricont (default options) and by the independent tracer of
 /// `tests/common/reference.rs` on its window: the same start, the same transitions at the
 /// same α to 1e-9 relative to max(1, |α|), and fricont ending at the window's end.
