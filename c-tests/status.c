@@ -585,6 +585,13 @@ static void test_strings(void) {
     CHECK(strcmp(fricont_status_str(-999), "unknown fricont status code") == 0, "unknown");
     CHECK(strcmp(fricont_class_name(FRICONT_SLIP_MINUS), "slip-") == 0, "slip-");
     CHECK(strcmp(fricont_class_name(42), "unknown") == 0, "unknown class");
+    CHECK(strcmp(fricont_end_reason_name(FRICONT_END_NONE), "none") == 0, "none");
+    CHECK(strcmp(fricont_end_reason_name(FRICONT_END_CLOSED_LOOP), "closed_loop") == 0, "loop");
+    CHECK(strcmp(fricont_end_reason_name(FRICONT_END_STOPPED), "stopped") == 0, "stopped");
+    CHECK(strcmp(fricont_end_reason_name(7), "unknown") == 0, "unknown end reason");
+    CHECK(strcmp(fricont_start_route_name(FRICONT_START_SOLVED), "solved") == 0, "solved");
+    CHECK(strcmp(fricont_start_route_name(FRICONT_START_ZERO_LOAD), "zero_load") == 0, "zero");
+    CHECK(strcmp(fricont_start_route_name(-1), "unknown") == 0, "unknown start route");
 }
 
 /* A mirror-symmetric pair of nodes (found by a search over such pairs, checked here

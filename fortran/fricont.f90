@@ -593,6 +593,16 @@ module fricont
             integer(c_int32_t), value :: c
             type(c_ptr) :: c_class_name
         end function
+        function c_end_reason_name(r) bind(C, name="fricont_end_reason_name")
+            import :: c_ptr, c_int32_t
+            integer(c_int32_t), value :: r
+            type(c_ptr) :: c_end_reason_name
+        end function
+        function c_start_route_name(r) bind(C, name="fricont_start_route_name")
+            import :: c_ptr, c_int32_t
+            integer(c_int32_t), value :: r
+            type(c_ptr) :: c_start_route_name
+        end function
         function c_version() bind(C, name="fricont_version")
             import :: c_ptr
             type(c_ptr) :: c_version
@@ -696,33 +706,18 @@ contains
     end function fricont_class_name
 
     !> Name of an end reason: "none", "window", "max_steps", "closed_loop",
-    !> "bifurcation", "failed", "stopped".
+    !> "bifurcation", "failed", "stopped" (or "unknown").
     function fricont_end_reason_name(code) result(s)
         integer, intent(in) :: code
         character(len=:), allocatable :: s
-        select case (code)
-        case (FRICONT_END_NONE); s = 'none'
-        case (FRICONT_END_WINDOW); s = 'window'
-        case (FRICONT_END_MAX_STEPS); s = 'max_steps'
-        case (FRICONT_END_CLOSED_LOOP); s = 'closed_loop'
-        case (FRICONT_END_BIFURCATION); s = 'bifurcation'
-        case (FRICONT_END_FAILED); s = 'failed'
-        case (FRICONT_END_STOPPED); s = 'stopped'
-        case default; s = 'unknown'
-        end select
+        s = c_string(c_end_reason_name(int(code, c_int32_t)))
     end function fricont_end_reason_name
 
-    !> Name of a start route: "solved", "nearby", "zero_load", "open".
+    !> Name of a start route: "solved", "nearby", "zero_load", "open" (or "unknown").
     function fricont_start_route_name(code) result(s)
         integer, intent(in) :: code
         character(len=:), allocatable :: s
-        select case (code)
-        case (FRICONT_START_SOLVED); s = 'solved'
-        case (FRICONT_START_NEARBY); s = 'nearby'
-        case (FRICONT_START_ZERO_LOAD); s = 'zero_load'
-        case (FRICONT_START_OPEN); s = 'open'
-        case default; s = 'unknown'
-        end select
+        s = c_string(c_start_route_name(int(code, c_int32_t)))
     end function fricont_start_route_name
 
     !> Description of a status code ("FRICONT_ERR_CSR: ...").

@@ -743,6 +743,25 @@ const char *fricont_status_str(int32_t status);
 const char *fricont_class_name(int32_t class_code);
 
 /**
+ * The name of an end reason code (`fricont_end_reason`, from `fricont_path_end_reason`):
+ * `"none"`, `"window"`, `"max_steps"`, `"closed_loop"`, `"bifurcation"`, `"failed"`,
+ * `"stopped"` (the names of the JSON exchange format and of the Python and MATLAB
+ * bindings), or `"unknown"` for any other value.
+ *
+ * The returned string is static (never free it). Thread-safe.
+ */
+const char *fricont_end_reason_name(int32_t reason);
+
+/**
+ * The name of a start route code (`fricont_start_route`, from
+ * `fricont_path_start_route`): `"solved"`, `"nearby"`, `"zero_load"`, `"open"` (the names
+ * of the Python and MATLAB bindings), or `"unknown"` for any other value.
+ *
+ * The returned string is static (never free it). Thread-safe.
+ */
+const char *fricont_start_route_name(int32_t route);
+
+/**
  * The library's version, `"MAJOR.MINOR.PATCH"` (static, NUL-terminated; never free it).
  * Compare with `FRICONT_VERSION_MAJOR` etc. to detect a header that does not match the
  * library you linked. Thread-safe.

@@ -94,18 +94,10 @@ enum class EndReason : int32_t {
     Stopped = FRICONT_END_STOPPED,
 };
 
-/// "none", "window", "max_steps", "closed_loop", "bifurcation", "failed" or "stopped".
+/// "none", "window", "max_steps", "closed_loop", "bifurcation", "failed" or "stopped"
+/// (`fricont_end_reason_name`).
 inline std::string name(EndReason r) {
-    switch (r) {
-    case EndReason::None: return "none";
-    case EndReason::Window: return "window";
-    case EndReason::MaxSteps: return "max_steps";
-    case EndReason::ClosedLoop: return "closed_loop";
-    case EndReason::Bifurcation: return "bifurcation";
-    case EndReason::Failed: return "failed";
-    case EndReason::Stopped: return "stopped";
-    }
-    return "unknown";
+    return fricont_end_reason_name(static_cast<int32_t>(r));
 }
 
 /// How `Path::start` reached the start point (`Path::start_route`): the fixed-α solver,
@@ -117,15 +109,9 @@ enum class StartRoute : int32_t {
     Open = FRICONT_START_OPEN,
 };
 
-/// "solved", "nearby", "zero_load" or "open".
+/// "solved", "nearby", "zero_load" or "open" (`fricont_start_route_name`).
 inline std::string name(StartRoute r) {
-    switch (r) {
-    case StartRoute::Solved: return "solved";
-    case StartRoute::Nearby: return "nearby";
-    case StartRoute::ZeroLoad: return "zero_load";
-    case StartRoute::Open: return "open";
-    }
-    return "unknown";
+    return fricont_start_route_name(static_cast<int32_t>(r));
 }
 
 /// The library's run-time version "MAJOR.MINOR.PATCH".

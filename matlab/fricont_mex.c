@@ -479,17 +479,6 @@ static void set_state_fields(mxArray *s, mwIndex k, const state_buf *b, int64_t 
 
 static const char *state_fields[] = {"alpha", "residual", "u", "lambda_n", "lambda_t", "classes"};
 
-static const char *end_reason_name(int32_t r) {
-    static const char *names[] = {"none",        "window", "max_steps", "closed_loop",
-                                  "bifurcation", "failed", "stopped"};
-    return r >= 0 && r <= 6 ? names[r] : "unknown";
-}
-
-static const char *start_route_name(int32_t r) {
-    static const char *names[] = {"solved", "nearby", "zero_load", "open"};
-    return r >= 0 && r <= 3 ? names[r] : "unknown";
-}
-
 /* ---- Commands -------------------------------------------------------------------- */
 
 #define NEED(k)                                                                        \
@@ -906,8 +895,8 @@ static void cmd_path_result(mxArray *plhs[], int nrhs, const mxArray *prhs[], co
     mxSetField(out, 0, "events", events);
     mxSetField(out, 0, "pieces", pcs);
     mxSetField(out, 0, "start", start);
-    mxSetField(out, 0, "end_reason", mxCreateString(end_reason_name(reason)));
-    mxSetField(out, 0, "start_route", mxCreateString(start_route_name(route)));
+    mxSetField(out, 0, "end_reason", mxCreateString(fricont_end_reason_name(reason)));
+    mxSetField(out, 0, "start_route", mxCreateString(fricont_start_route_name(route)));
     mxSetField(out, 0, "n", mxCreateDoubleScalar((double)n));
     mxSetField(out, 0, "p", mxCreateDoubleScalar((double)p));
     mxSetField(out, 0, "callback_code", mxCreateDoubleScalar((double)code));

@@ -239,6 +239,15 @@ contains
         call check('affine: the fixed-alpha solver found the start', &
                    path%start_route() == FRICONT_START_SOLVED, &
                    fricont_start_route_name(path%start_route()))
+        block
+            character(len=:), allocatable :: route_name, end_name, bad_name
+            route_name = fricont_start_route_name(path%start_route())
+            end_name = fricont_end_reason_name(reason)
+            bad_name = fricont_end_reason_name(99)
+            call check('affine: the names of the route and the end', &
+                       route_name == 'solved' .and. end_name == 'window' .and. &
+                       bad_name == 'unknown', route_name // ' ' // end_name // ' ' // bad_name)
+        end block
 
         block
             type(fricont_path) :: p0
@@ -329,6 +338,7 @@ contains
             type(fricont_path), target :: mp
             type(monitor_log), target :: log
             type(fricont_event), allocatable :: em(:)
+            character(len=:), allocatable :: rname
             call mp%create_affine(prob, c%f0, c%f1)
             call mp%set_window(c%alpha_start, c%alpha_end)
             log%path => mp
@@ -337,10 +347,10 @@ contains
             call mp%run(reason)
             em = mp%events()
             k = mp%end_reason()
+            rname = fricont_end_reason_name(reason)
             call check('monitor: stops after 3 transition points (FRICONT_END_STOPPED)', &
                        reason == FRICONT_END_STOPPED .and. k == FRICONT_END_STOPPED .and. &
-                       log%calls == 3 .and. fricont_end_reason_name(reason) == 'stopped', &
-                       fricont_end_reason_name(reason))
+                       log%calls == 3 .and. rname == 'stopped', rname)
             same = size(em) == log%last_event .and. size(em) < size(ev)
             if (same) same = all(em%alpha == ev(1:size(em))%alpha) .and. &
                              all(em%node == ev(1:size(em))%node) .and. &

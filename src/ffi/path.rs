@@ -11,7 +11,7 @@ use super::boundary::{
 use super::problem::fricont_problem;
 use super::status::{class_code, fricont_end_reason, fricont_start_route, fricont_status};
 use crate::load::{Load, LoadFailure};
-use crate::path::{EndReason, Path, PathOptions, Solution, StartRoute, State, StepOutcome};
+use crate::path::{Path, PathOptions, Solution, State, StepOutcome};
 use crate::problem::Problem;
 
 /// A general load callback: writes `f(α)` (or its derivative `f'(α)` when registered as
@@ -996,15 +996,7 @@ pub unsafe extern "C" fn fricont_path_end_reason(
         if reason.is_null() {
             return Err(Failure::null("reason"));
         }
-        let code = match h.started()?.end_reason() {
-            None => fricont_end_reason::FRICONT_END_NONE,
-            Some(EndReason::Window) => fricont_end_reason::FRICONT_END_WINDOW,
-            Some(EndReason::MaxSteps) => fricont_end_reason::FRICONT_END_MAX_STEPS,
-            Some(EndReason::ClosedLoop) => fricont_end_reason::FRICONT_END_CLOSED_LOOP,
-            Some(EndReason::Bifurcation) => fricont_end_reason::FRICONT_END_BIFURCATION,
-            Some(EndReason::Failed(_)) => fricont_end_reason::FRICONT_END_FAILED,
-            Some(EndReason::Stopped) => fricont_end_reason::FRICONT_END_STOPPED,
-        };
+        let code = fricont_end_reason::of(h.started()?.end_reason());
         // SAFETY: non-NULL and valid by contract.
         unsafe { reason.write(code as i32) };
         Ok(fricont_status::FRICONT_OK)
@@ -1033,13 +1025,10 @@ pub unsafe extern "C" fn fricont_path_start_route(
         if route.is_null() {
             return Err(Failure::null("route"));
         }
-        let code = match h.started()?.start_route() {
-            Some(StartRoute::Solved) => fricont_start_route::FRICONT_START_SOLVED,
-            Some(StartRoute::Nearby) => fricont_start_route::FRICONT_START_NEARBY,
-            Some(StartRoute::ZeroLoad) => fricont_start_route::FRICONT_START_ZERO_LOAD,
-            Some(StartRoute::Open) => fricont_start_route::FRICONT_START_OPEN,
-            None => return Err(Failure::order(NOT_STARTED)),
+        let Some(started) = h.started()?.start_route() else {
+            return Err(Failure::order(NOT_STARTED));
         };
+        let code = fricont_start_route::of(started);
         // SAFETY: non-NULL and valid by contract.
         unsafe { route.write(code as i32) };
         Ok(fricont_status::FRICONT_OK)

@@ -1,9 +1,10 @@
 //! Status codes, enumerations passed as `int32_t`, version, and the thread-local error.
 
-use std::ffi::{c_char, c_int};
+use std::ffi::{CStr, c_char, c_int};
 
 use super::boundary::{self, write_message};
 use crate::class::Class;
+use crate::path::{EndReason, StartRoute};
 
 /// Major version of the library this header belongs to (compare with `fricont_version()`
 /// at run time to detect a header/library mismatch).
@@ -255,6 +256,50 @@ pub enum fricont_end_reason {
     FRICONT_END_STOPPED = 6,
 }
 
+impl fricont_end_reason {
+    /// Every end reason, in code order.
+    pub const ALL: [fricont_end_reason; 7] = {
+        use fricont_end_reason::*;
+        [
+            FRICONT_END_NONE,
+            FRICONT_END_WINDOW,
+            FRICONT_END_MAX_STEPS,
+            FRICONT_END_CLOSED_LOOP,
+            FRICONT_END_BIFURCATION,
+            FRICONT_END_FAILED,
+            FRICONT_END_STOPPED,
+        ]
+    };
+
+    /// The code of a path's end reason (`None`: not ended).
+    pub(crate) fn of(reason: Option<&EndReason>) -> Self {
+        use fricont_end_reason::*;
+        match reason {
+            None => FRICONT_END_NONE,
+            Some(EndReason::Window) => FRICONT_END_WINDOW,
+            Some(EndReason::MaxSteps) => FRICONT_END_MAX_STEPS,
+            Some(EndReason::ClosedLoop) => FRICONT_END_CLOSED_LOOP,
+            Some(EndReason::Bifurcation) => FRICONT_END_BIFURCATION,
+            Some(EndReason::Failed(_)) => FRICONT_END_FAILED,
+            Some(EndReason::Stopped) => FRICONT_END_STOPPED,
+        }
+    }
+
+    /// [`EndReason::name`] as a C string (`"none"` for `FRICONT_END_NONE`).
+    fn name(self) -> &'static CStr {
+        use fricont_end_reason::*;
+        match self {
+            FRICONT_END_NONE => c"none",
+            FRICONT_END_WINDOW => c"window",
+            FRICONT_END_MAX_STEPS => c"max_steps",
+            FRICONT_END_CLOSED_LOOP => c"closed_loop",
+            FRICONT_END_BIFURCATION => c"bifurcation",
+            FRICONT_END_FAILED => c"failed",
+            FRICONT_END_STOPPED => c"stopped",
+        }
+    }
+}
+
 /// How `fricont_path_start` reached the start point (`fricont_path_start_route`). Every
 /// route ends in the same check: the start point solves the problem at the start's α to
 /// 1e-12 relative. Where the problem has several solutions there (large friction, a path
@@ -273,6 +318,41 @@ pub enum fricont_start_route {
     /// As `FRICONT_START_ZERO_LOAD`, but that path could not leave tau = 0 (every gap
     /// zero); the path from a load that holds every node open reached it.
     FRICONT_START_OPEN = 3,
+}
+
+impl fricont_start_route {
+    /// Every start route, in code order.
+    pub const ALL: [fricont_start_route; 4] = {
+        use fricont_start_route::*;
+        [
+            FRICONT_START_SOLVED,
+            FRICONT_START_NEARBY,
+            FRICONT_START_ZERO_LOAD,
+            FRICONT_START_OPEN,
+        ]
+    };
+
+    /// The code of a start route.
+    pub(crate) fn of(route: StartRoute) -> Self {
+        use fricont_start_route::*;
+        match route {
+            StartRoute::Solved => FRICONT_START_SOLVED,
+            StartRoute::Nearby => FRICONT_START_NEARBY,
+            StartRoute::ZeroLoad => FRICONT_START_ZERO_LOAD,
+            StartRoute::Open => FRICONT_START_OPEN,
+        }
+    }
+
+    /// [`StartRoute::name`] as a C string.
+    fn name(self) -> &'static CStr {
+        use fricont_start_route::*;
+        match self {
+            FRICONT_START_SOLVED => c"solved",
+            FRICONT_START_NEARBY => c"nearby",
+            FRICONT_START_ZERO_LOAD => c"zero_load",
+            FRICONT_START_OPEN => c"open",
+        }
+    }
 }
 
 /// A static, NUL-terminated description of a status code: the enumerator's name, a colon
@@ -304,6 +384,39 @@ pub extern "C" fn fricont_class_name(class_code: i32) -> *const c_char {
         2 => c"slip+".as_ptr(),
         3 => c"slip-".as_ptr(),
         _ => c"unknown".as_ptr(),
+    })
+}
+
+/// The name of an end reason code (`fricont_end_reason`, from `fricont_path_end_reason`):
+/// `"none"`, `"window"`, `"max_steps"`, `"closed_loop"`, `"bifurcation"`, `"failed"`,
+/// `"stopped"` (the names of the JSON exchange format and of the Python and MATLAB
+/// bindings), or `"unknown"` for any other value.
+///
+/// The returned string is static (never free it). Thread-safe.
+#[unsafe(no_mangle)]
+pub extern "C" fn fricont_end_reason_name(reason: i32) -> *const c_char {
+    boundary::run_value(c"unknown".as_ptr(), || {
+        fricont_end_reason::ALL
+            .iter()
+            .find(|r| **r as i32 == reason)
+            .map_or(c"unknown", |r| r.name())
+            .as_ptr()
+    })
+}
+
+/// The name of a start route code (`fricont_start_route`, from
+/// `fricont_path_start_route`): `"solved"`, `"nearby"`, `"zero_load"`, `"open"` (the names
+/// of the Python and MATLAB bindings), or `"unknown"` for any other value.
+///
+/// The returned string is static (never free it). Thread-safe.
+#[unsafe(no_mangle)]
+pub extern "C" fn fricont_start_route_name(route: i32) -> *const c_char {
+    boundary::run_value(c"unknown".as_ptr(), || {
+        fricont_start_route::ALL
+            .iter()
+            .find(|r| **r as i32 == route)
+            .map_or(c"unknown", |r| r.name())
+            .as_ptr()
     })
 }
 
@@ -377,6 +490,52 @@ mod tests {
         }
         let t = unsafe { std::ffi::CStr::from_ptr(fricont_status_str(12345)) };
         assert_eq!(t.to_str().unwrap(), "unknown fricont status code");
+    }
+
+    fn c_str(p: *const c_char) -> &'static str {
+        unsafe { CStr::from_ptr(p) }.to_str().unwrap()
+    }
+
+    #[test]
+    fn end_reason_and_start_route_names_are_the_rust_names() {
+        let reasons = [
+            EndReason::Window,
+            EndReason::MaxSteps,
+            EndReason::ClosedLoop,
+            EndReason::Bifurcation,
+            EndReason::Failed("x".into()),
+            EndReason::Stopped,
+        ];
+        assert_eq!(c_str(fricont_end_reason_name(0)), "none");
+        for r in &reasons {
+            let code = fricont_end_reason::of(Some(r)) as i32;
+            assert_eq!(c_str(fricont_end_reason_name(code)), r.name());
+        }
+        let routes = [
+            StartRoute::Solved,
+            StartRoute::Nearby,
+            StartRoute::ZeroLoad,
+            StartRoute::Open,
+        ];
+        for r in routes {
+            let code = fricont_start_route::of(r) as i32;
+            assert_eq!(c_str(fricont_start_route_name(code)), r.name());
+        }
+        // Every code is one of those, in order; any other value is "unknown".
+        assert_eq!(fricont_end_reason::ALL.len(), reasons.len() + 1);
+        assert_eq!(fricont_start_route::ALL.len(), routes.len());
+        for (k, r) in fricont_end_reason::ALL.iter().enumerate() {
+            assert_eq!(*r as i32, k as i32);
+        }
+        for (k, r) in fricont_start_route::ALL.iter().enumerate() {
+            assert_eq!(*r as i32, k as i32);
+        }
+        for bad in [-1, 7, i32::MIN, i32::MAX] {
+            assert_eq!(c_str(fricont_end_reason_name(bad)), "unknown");
+        }
+        for bad in [-1, 4, i32::MIN, i32::MAX] {
+            assert_eq!(c_str(fricont_start_route_name(bad)), "unknown");
+        }
     }
 
     #[test]
