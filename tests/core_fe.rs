@@ -323,18 +323,8 @@ fn in_double_against(
     match path.run() {
         Err(e) => assert!(may_fail, "{ctx}, in double: {e}"),
         Ok(EndReason::Window) => {
-            let got: Vec<common::reference::Ev> = path
-                .events()
-                .iter()
-                .map(|e| (e.alpha, e.node, e.from, e.to))
-                .collect();
-            let want: Vec<common::reference::Ev> = exact
-                .reference
-                .events
-                .iter()
-                .map(|e| (e.alpha, e.node, e.from, e.to))
-                .collect();
-            common::reference::compare_events(&got, &want, tol)
+            let got = common::reference::path_events(&path);
+            common::reference::compare_events(&got, &exact.reference.evs(), tol)
                 .unwrap_or_else(|e| panic!("{ctx}, in double: {e}"));
         }
         Ok(r) => panic!(

@@ -613,12 +613,7 @@ fn walk_case(
     let c = common::reference::compare_case(&case, problem.clone(), 1e-9);
     c.check(1e-9)
         .unwrap_or_else(|e| panic!("{ctx}, affine: {e}"));
-    let up: Vec<(f64, usize, Class, Class)> = c
-        .reference
-        .events
-        .iter()
-        .map(|e| (e.alpha, e.node, e.from, e.to))
-        .collect();
+    let up = c.reference.evs();
     assert!(up.len() >= min_events, "{ctx}: {} events", up.len());
     // back: the transitions in reverse order (events of one transition in node
     // order), each event's classes swapped

@@ -334,11 +334,7 @@ fn mirror_symmetric_bodies_under_an_oscillating_load() {
             Some(EndReason::Bifurcation) => {}
             r => panic!("{ctx}: ends with {r:?}"),
         }
-        let ev: Vec<(f64, usize, Class, Class)> = path
-            .events()
-            .iter()
-            .map(|e| (e.alpha, e.node, e.from, e.to))
-            .collect();
+        let ev = common::reference::path_events(&path);
         pairs += assert_mirrored(&ctx, &ev, nx);
     }
     eprintln!("{windows} windows, {pairs} mirrored events");
@@ -374,12 +370,7 @@ fn mirror_symmetric_finite_element_bodies() {
         );
         let ev = &c.fricont;
         pairs += assert_mirrored(&ctx, ev, nx);
-        let want: Vec<common::reference::Ev> = c
-            .reference
-            .events
-            .iter()
-            .map(|e| (e.alpha, e.node, e.from, e.to))
-            .collect();
+        let want = c.reference.evs();
         let (end_alpha, reason) = &c.fricont_end;
         match reason.as_str() {
             "window" => {
@@ -469,12 +460,7 @@ fn mirror_symmetric_bodies_in_double_precision() {
         }
         let c = compare_case(&case, problem, 1e-8);
         assert!(c.reference.end.is_ok(), "{ctx}: {:?}", c.reference.end);
-        let want: Vec<common::reference::Ev> = c
-            .reference
-            .events
-            .iter()
-            .map(|e| (e.alpha, e.node, e.from, e.to))
-            .collect();
+        let want = c.reference.evs();
         compare_events(&c.fricont, &want, 1e-8).unwrap_or_else(|e| panic!("{ctx}: {e}"));
         pairs += assert_mirrored(&ctx, &c.fricont, nx);
     }
@@ -572,11 +558,7 @@ fn larger_mirror_symmetric_bodies_in_double_match_extended_precision() {
                 path.events().iter().all(|e| !e.bifurcation),
                 "{ctx}, {mode:?}: an event flagged as a bifurcation"
             );
-            let ev: Vec<(f64, usize, Class, Class)> = path
-                .events()
-                .iter()
-                .map(|e| (e.alpha, e.node, e.from, e.to))
-                .collect();
+            let ev = common::reference::path_events(&path);
             (ev, end)
         };
         let (double, end_double) = trace(fricont::ExtendedPrecision::Off);
@@ -673,10 +655,7 @@ fn unflagged_in_double(
             e.alpha
         );
     }
-    path.events()
-        .iter()
-        .map(|e| (e.alpha, e.node, e.from, e.to))
-        .collect()
+    common::reference::path_events(&path)
 }
 
 /// A mirror-symmetric body of 660 contact nodes ([`common::symmetric_fe_case`] seed 107,
@@ -707,11 +686,7 @@ fn a_symmetric_bifurcation_in_double_is_not_decided_by_rounding() {
         path.start(0.0, None).expect("start");
         path.run().unwrap_or_else(|e| panic!("{ctx}: {e}"));
         assert_eq!(path.end_reason(), Some(&EndReason::Bifurcation), "{ctx}");
-        let ev: Vec<(f64, usize, Class, Class)> = path
-            .events()
-            .iter()
-            .map(|e| (e.alpha, e.node, e.from, e.to))
-            .collect();
+        let ev = common::reference::path_events(&path);
         let branches: BTreeSet<Vec<Class>> =
             path.branches().iter().map(|b| b.classes.clone()).collect();
         let stop = path.current().expect("state at the stop").alpha;

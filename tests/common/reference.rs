@@ -1194,6 +1194,24 @@ impl Condensed {
 /// An event as `(α, node, from, to)`.
 pub type Ev = (f64, usize, Class, Class);
 
+/// fricont's events of `path` as [`Ev`].
+pub fn path_events(path: &fricont::Path) -> Vec<Ev> {
+    path.events()
+        .iter()
+        .map(|e| (e.alpha, e.node, e.from, e.to))
+        .collect()
+}
+
+impl RefTrace {
+    /// The reference's events as [`Ev`].
+    pub fn evs(&self) -> Vec<Ev> {
+        self.events
+            .iter()
+            .map(|e| (e.alpha, e.node, e.from, e.to))
+            .collect()
+    }
+}
+
 /// Compares traced events `got` with the reference `want`: events are grouped into
 /// clusters of consecutive events whose α agree within `tol` (relative to max(1, |α|)),
 /// clusters must pair up with equal multisets of `(node, from, to)` and α within `tol`.
@@ -1343,12 +1361,7 @@ impl Comparison {
         }
         if let Err(e) = &self.events {
             errs.push(e.clone());
-            let want: Vec<Ev> = self
-                .reference
-                .events
-                .iter()
-                .map(|e| (e.alpha, e.node, e.from, e.to))
-                .collect();
+            let want = self.reference.evs();
             let d = differences(&self.fricont, &want, tol);
             errs.push(format!(
                 "{} of {} reference events differ from fricont's nearest event of the same node and kind by more than {tol:e}; the largest:\n{}",
@@ -1480,11 +1493,7 @@ pub fn compare_with_fricont(
     let route = path.start_route().expect("started");
     let run = path.run();
     let fr_secs = t.elapsed().as_secs_f64();
-    let fricont: Vec<Ev> = path
-        .events()
-        .iter()
-        .map(|e| (e.alpha, e.node, e.from, e.to))
-        .collect();
+    let fricont = path_events(&path);
     let end_alpha = path.pieces().last().map_or(a0, |p| p.alpha_to);
     let reason = match (&run, path.end_reason()) {
         (Err(e), _) => format!("error: {e}"),
@@ -1537,11 +1546,7 @@ pub fn compare_with_fricont(
         }
         _ => 0.0,
     };
-    let want: Vec<Ev> = reference
-        .events
-        .iter()
-        .map(|e| (e.alpha, e.node, e.from, e.to))
-        .collect();
+    let want = reference.evs();
     let events = compare_events(&fricont, &want, tol);
     let folds = (
         path.events().iter().filter(|e| e.fold).count(),
