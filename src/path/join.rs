@@ -9,7 +9,7 @@ use crate::dense::max_abs_diff;
 /// The widest of `transit`'s last-resort thresholds, as a multiple of the usual ones.
 pub(super) const MAX_WIDENING: f64 = 64.0;
 
-/// The usual thresholds [`MAX_WIDENING`] times wider, an open node's λt against F times
+/// The usual thresholds [`MAX_WIDENING`] times wider, an open node's λt against 1 + F times
 /// them ([`Widen::cone`]): what any of `transit`'s retries could let a node fit.
 const WIDEST: Widen = Widen {
     k: MAX_WIDENING,
@@ -78,19 +78,31 @@ impl Path {
     }
 
     /// `transit`'s last-resort thresholds at `pt`, as arguments of [`Tol::widened`]: first
+    /// the usual ones with [`Widen::cone`] (the forces' own rounding: an open node's λt
+    /// against 1 + F times its threshold, nothing else wider); then
     /// [`Self::determined`]; then, in double, all of them 4, 16 and 64 times wider, as far
     /// as κ(W) times the relative error of the condensation
     /// ([`crate::load::BoundLoad::relative_determination`], about κ(A) ε) exceeds
-    /// `zero_tol` (the forces are undetermined by that much); last, the first with
-    /// [`Widen::cone`] (alone where the determination is not known).
+    /// `zero_tol` (the forces are undetermined by that much); last, the determined ones
+    /// with [`Widen::cone`]. (The cone's alone where the determination is not known.)
+    ///
+    /// The cone's come before the data's determination, which widens the displacement
+    /// rows by orders of magnitude: on slender strips in double (`fe_strip` seeds 6 and
+    /// 1597, κ(W) 1.8e8 and 1.0e8, F = 5 and 1) a slipping node's λν reached 0 with its
+    /// λt above its usual threshold by rounding, so no class fitted it; at the data's
+    /// determination its tangential displacement (7.8e-8 and 6.7e-8 in force units, about 1e6
+    /// times its usual threshold) counted as zero, and stick (reversing α, a fold the
+    /// path does not have) or slip the other way was taken where the independent
+    /// reference lifts off. Each path then stopped with a node fitting no class.
     fn widening(&self, pt: &Point) -> Vec<Widen> {
-        let Some(first) = self.determined(pt) else {
-            return vec![Widen {
-                cone: true,
-                ..Widen::USUAL
-            }];
+        let cone = Widen {
+            cone: true,
+            ..Widen::USUAL
         };
-        let mut out = vec![first];
+        let Some(first) = self.determined(pt) else {
+            return vec![cone];
+        };
+        let mut out = vec![cone, first];
         if !self.problem.extended_precision() {
             // `first.determined` is the condensation's relative error
             let bound = self.problem.w_condition_estimate() * first.determined / self.opts.zero_tol;
@@ -955,18 +967,20 @@ impl Path {
             }
         }
         // The last resort where the usual thresholds find no continuation or several, as
-        // the data may determine the point less well than they assume (`widening`): no
-        // displacement row's threshold below how far the data determine q's rows, then
+        // the point may carry more rounding, or the data determine it less well, than they
+        // assume (`widening`): an open node's λt against 1 + F times its threshold (its λν
+        // is at zero to its threshold, and |λt| ≤ F λν: with F = 5 a slipping node lifting
+        // off with its mirror image, λν at 0.84 of its threshold, did not fit open), then
+        // no displacement row's threshold below how far the data determine q's rows, then
         // all thresholds 4, 16, 64 times wider as far as the forces are undetermined (in
-        // double only), last an open node's λt against F times its threshold (its λν is
-        // at zero to its threshold, and |λt| ≤ F λν: with F = 5 a slipping node lifting
-        // off with its mirror image, λν at 0.84 of its threshold, did not fit open). The
+        // double only), last the determined ones with the cone's. The
         // first that finds exactly one continuation is taken; else what the usual
         // thresholds found. (Where they found none, the first widening that found several
         // used to be taken: reached by no test, and in sweeps of 2,300 traces only once, on
         // a strip in double (`fe_strip` seed 1597, κ(W) = 1e8), where it took a piece that
         // led the path back onto its own and ended it as a closed loop that the path does
-        // not have; without it that trace fails loudly, "node 59 fits no class".)
+        // not have; without it that trace failed loudly, "node 59 fits no class", until
+        // the cone's thresholds came first: it now follows the reference.)
         // On mirror-symmetric bodies, whose W and q are symmetric to about κ(A) ε only:
         // the node on the axis touched down with a tangential displacement of 1.6e-14 of
         // the load's scale (0 by symmetry) and no class fitted it; in double a mirrored

@@ -365,7 +365,7 @@ pub(super) struct Tol {
     widen: f64,
     min_row: f64,
     determined: f64,
-    /// An open node's `λt = 0` judged against F times its threshold ([`Widen::cone`],
+    /// An open node's `λt = 0` judged against 1 + F times its threshold ([`Widen::cone`],
     /// [`Tol::cone_factor`]; false otherwise).
     cone: bool,
     /// The rows' terms are estimated (a general load, see [`Path::term_rows`]): a guard
@@ -392,12 +392,17 @@ pub(super) struct Widen {
     /// the path stuck, and stopped there; on smaller strips it reported open → stick
     /// where the node slips first, without an error.
     pub determined: f64,
-    /// An open node's `λt = 0` judged against `F_i` (clamped to [1, 64],
+    /// An open node's `λt = 0` judged against `1 + F_i` (at most 64,
     /// [`Tol::cone_factor`]) times its threshold. A node leaving contact has
     /// `|λt| ≤ F λν`, so where `λν` is at zero to its threshold, `λt` is at zero to F
-    /// times it: a slipping node (F = 5) lifting off with its mirror image had
-    /// λν = 4.6e-15 against a threshold of 5.4e-15 and λt = 2.3e-14, and open did not
-    /// fit it.
+    /// times it; and a slipping node's `λt = ∓F λν` holds to its own threshold, which is
+    /// 1 + F times the force threshold (the form's coefficients), so at `λν = 0` its `λt`
+    /// is rounding up to that. A slipping node (F = 5) lifting off with its mirror image
+    /// had λν = 4.6e-15 against a threshold of 5.4e-15 and λt = 2.3e-14, and open did not
+    /// fit it. On slender strips in double, F = 1, a slipping node's λν reached 0 with
+    /// λt = −2.2e-12 against a threshold of 1.5e-12 (F times it did not fit either), and
+    /// a node fitting no class at the usual thresholds fitted the wrong one at the data's
+    /// determination (see `Path::widening`).
     pub cone: bool,
 }
 
@@ -578,14 +583,14 @@ impl Tol {
     }
 
     /// The factor on the threshold of an open node's `λt = 0` (`open_t`) at a node of
-    /// (equilibrated) friction coefficient `friction`: `F` between 1 and the retries'
-    /// widest factor ([`join::MAX_WIDENING`]) where [`Widen::cone`] is set, else 1. Beyond
-    /// that, F times a threshold is no longer rounding: with a node's tangential row 1e300
-    /// times its normal one (F 1e300 times larger once equilibrated), open fitted a node
-    /// whose λt was not zero, and the event's residual was 1.7e-3.
+    /// (equilibrated) friction coefficient `friction`: `1 + F`, at most the retries'
+    /// widest factor ([`join::MAX_WIDENING`]), where [`Widen::cone`] is set, else 1.
+    /// Beyond that, F times a threshold is no longer rounding: with a node's tangential
+    /// row 1e300 times its normal one (F 1e300 times larger once equilibrated), open
+    /// fitted a node whose λt was not zero, and the event's residual was 1.7e-3.
     pub(super) fn cone_factor(&self, open_t: bool, friction: f64) -> f64 {
         if self.cone && open_t {
-            friction.clamp(1.0, join::MAX_WIDENING)
+            (1.0 + friction).min(join::MAX_WIDENING)
         } else {
             1.0
         }
