@@ -795,3 +795,124 @@ fn a_general_load_does_not_merge_a_grazing_touchdown_into_another_transition() {
         );
     }
 }
+
+/// Loads that turn just past a transition: `φ(α) = s_max − A + A(1 − cos 5α)`, A = 1/2,
+/// rising to its maximum `s_max = s_k + d max(1, |s_k|)` at α = π/5 and back, where `s_k`
+/// is a lift-off of the affine path (the independent reference of
+/// `tests/common/reference.rs` on a stretch of φ around it). The node lifts off at the α
+/// where φ = s_k rising and touches down again at its mirror image about π/5, and every
+/// other transition of the stretch is met up and back the same way: the expected events
+/// are the reference's through φ (classes swapped where φ falls), to 1e-8 in φ, no fold,
+/// and the path must reach the window's end. The gap of the node lifting off rises by a
+/// few thresholds at most (d = 1e-5) or less than one (d = 1e-8): the march took the
+/// piece's entry as that guard's root, or φ's turn itself, and the path folded back to
+/// the window's start without an error (found by a sweep of 7,702 turning loads against
+/// the reference: three such traces, all near a turn; graze scans of one strip at
+/// d = 1e-8 … 1e-2 gave 70 of 1440 under a basis load, 111 under a general one).
+#[test]
+fn a_load_turning_just_past_a_lift_off_comes_back_through_it() {
+    // (strip, node of the lift-off (1-based), d, the load as a general load too)
+    let cases = [
+        (
+            (2u64, 57usize, 3usize, 0.46368478231107124, 0.277),
+            46usize,
+            1e-5,
+            true,
+        ),
+        ((2, 57, 3, 0.46368478231107124, 0.277), 46, 1e-6, true),
+        ((98, 138, 1, 0.4951900771206396, 0.178), 129, 1e-8, false),
+    ];
+    let (amp, omega, wspan) = (0.5, 5.0, 0.05);
+    for ((seed, nx, ny, f, ly), node, d, general) in cases {
+        let strip = common::fe_strip(seed, nx, ny, f, 10.0, ly);
+        // The affine reference over a stretch of φ holding the lift-off (found first on a
+        // wider one, then each trace's expected events from it).
+        let mut case = common::fe_strip(seed, nx, ny, f, 10.0, ly);
+        (case.a0, case.a1) = (-3.0, 3.0);
+        let problem = Arc::new(case.data.problem());
+        let wide = common::reference::compare_case(&case, problem.clone(), 1e-9);
+        let sk = wide
+            .reference
+            .evs()
+            .into_iter()
+            .find(|e| e.1 + 1 == node && e.3 == Class::Open)
+            .expect("the lift-off")
+            .0;
+        let smax = sk + d * sk.abs().max(1.0);
+        (case.a0, case.a1) = (smax - 2.0 * wspan, smax + wspan);
+        let c = common::reference::compare_case(&case, problem.clone(), 1e-9);
+        c.check(1e-9)
+            .unwrap_or_else(|e| panic!("seed {seed}, affine: {e}"));
+        let sc = smax - amp;
+        let phi = move |a: f64| sc - amp * (omega * a).cos();
+        let th = ((sc - (smax - wspan)) / amp).acos();
+        let (start, end) = (th / omega, (2.0 * PI - th) / omega);
+        // Each reference event on (φ(start), s_max) met rising at α = acos((sc − s)/A)/ω
+        // and falling at its mirror image 2π/ω − α.
+        let mut want: Vec<(f64, f64, usize, Class, Class)> = Vec::new();
+        for (s, i, from, to) in c.reference.evs() {
+            if s > smax - wspan && s < smax {
+                let a = ((sc - s) / amp).acos() / omega;
+                want.push((a, s, i, from, to));
+                want.push((2.0 * PI / omega - a, s, i, to, from));
+            }
+        }
+        want.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+        assert!(
+            want.iter().any(|w| w.2 + 1 == node),
+            "seed {seed}: the lift-off"
+        );
+        let forms: &[&str] = if general {
+            &["basis", "general"]
+        } else {
+            &["basis"]
+        };
+        for &form in forms {
+            let ctx = format!("seed {seed}, {nx} × {ny}, d = {d:e}, {form} load");
+            let load = if form == "basis" {
+                let weights = move |a: f64, w: &mut [f64], dw: &mut [f64]| {
+                    w[0] = 1.0;
+                    w[1] = phi(a);
+                    dw[0] = 0.0;
+                    dw[1] = amp * omega * (omega * a).sin();
+                    Ok::<(), LoadFailure>(())
+                };
+                let vs = vec![
+                    strip.data.f0.as_slice().to_vec(),
+                    strip.data.f1.as_slice().to_vec(),
+                ];
+                Load::basis(vs, Box::new(weights)).unwrap()
+            } else {
+                general_along(&strip.data, phi)
+            };
+            let mut path =
+                Path::new(problem.clone(), load, PathOptions::window(start, end)).unwrap();
+            path.start(start, None).unwrap();
+            assert_eq!(path.run().unwrap(), EndReason::Window, "{ctx}");
+            assert!(path.events().iter().all(|e| !e.fold), "{ctx}: a fold");
+            let mut got: Vec<(f64, f64, usize, Class, Class)> = path
+                .events()
+                .iter()
+                .map(|e| (e.alpha, phi(e.alpha), e.node, e.from, e.to))
+                .collect();
+            // (events of one transition in node order, as the expected ones)
+            got.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.2.cmp(&y.2)));
+            assert_eq!(got.len(), want.len(), "{ctx}: events {got:?}");
+            for (g, w) in got.iter().zip(&want) {
+                assert!(
+                    (g.2, g.3, g.4) == (w.2, w.3, w.4)
+                        && (g.1 - w.1).abs() <= 1e-8 * w.1.abs().max(1.0),
+                    "{ctx}: event at φ {} node {} {:?} → {:?}, expected φ {} node {} {:?} → {:?}",
+                    g.1,
+                    g.2 + 1,
+                    g.3,
+                    g.4,
+                    w.1,
+                    w.2 + 1,
+                    w.3,
+                    w.4
+                );
+            }
+        }
+    }
+}

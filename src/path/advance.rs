@@ -1238,12 +1238,19 @@ impl Path {
                 // threshold opens its node for a stretch of α shorter than a step): its
                 // root is the one after its maximum on that step (Brent on its slope),
                 // where the maximum is above zero. Taken at α_a, the touchdown was 3.8e-8
-                // in α late under a basis load whose force dipped by 2e-12.
+                // in α late under a basis load whose force dipped by 2e-12. Also where it
+                // was above zero at the step's start (`earlier`): that start may be the
+                // guard's other root, the piece's entry. Under a load that turns just past
+                // a transition (φ's maximum 1e-5 beyond a lift-off, relative), the gap of
+                // the node lifting off rose to 3e-11 (threshold 1.5e-11) and came back,
+                // and the root taken on the whole step was the entry itself: the node
+                // touched down again at the α where it lifted off, the way back was taken
+                // as a fold, and the path went back to the window's start, without an
+                // error.
                 let turned = behind
                     .as_ref()
                     .filter(|(_, rows)| {
-                        earlier.is_none()
-                            && fa <= 0.0
+                        fa <= 0.0
                             && dir * ga[k].slope < 0.0
                             && rows[k].guard == g
                             && dir * rows[k].slope > 0.0
@@ -1272,8 +1279,18 @@ impl Path {
                 } else {
                     Some((sa, (b0, fb, gb[k].slope)))
                 };
+                // After a maximum the guard is flat: a value within `fine` of its
+                // threshold may lie far from the root in α, and the maximum itself passed
+                // as the root where it was below that (at a turn of φ 1e-8 past a
+                // lift-off, the gap's maximum was 8e-14 against 9e-14, and the node touched
+                // down at φ's turn, where no direction along α is decided). There the value
+                // must also be below a sixteenth of the maximum's.
+                let accept = match peak {
+                    Some((_, top, _)) => (fine * tol[k]).min(top / 16.0),
+                    None => fine * tol[k],
+                };
                 let root = match bracket {
-                    Some((from, to)) => newton_bracketed(from, to, fine * tol[k], |x| {
+                    Some((from, to)) => newton_bracketed(from, to, accept, |x| {
                         let rows = eval(self, x, false)?.1;
                         Ok((rows[k].value, rows[k].slope))
                     })?,
