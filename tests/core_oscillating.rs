@@ -824,7 +824,6 @@ fn a_load_turning_just_past_a_lift_off_comes_back_through_it() {
     ];
     let (amp, omega, wspan) = (0.5, 5.0, 0.05);
     for ((seed, nx, ny, f, ly), node, d, general) in cases {
-        let strip = common::fe_strip(seed, nx, ny, f, 10.0, ly);
         // The affine reference over a stretch of φ holding the lift-off (found first on a
         // wider one, then each trace's expected events from it).
         let mut case = common::fe_strip(seed, nx, ny, f, 10.0, ly);
@@ -878,12 +877,12 @@ fn a_load_turning_just_past_a_lift_off_comes_back_through_it() {
                     Ok::<(), LoadFailure>(())
                 };
                 let vs = vec![
-                    strip.data.f0.as_slice().to_vec(),
-                    strip.data.f1.as_slice().to_vec(),
+                    case.data.f0.as_slice().to_vec(),
+                    case.data.f1.as_slice().to_vec(),
                 ];
                 Load::basis(vs, Box::new(weights)).unwrap()
             } else {
-                general_along(&strip.data, phi)
+                general_along(&case.data, phi)
             };
             let mut path =
                 Path::new(problem.clone(), load, PathOptions::window(start, end)).unwrap();
