@@ -450,10 +450,10 @@ fn starts_where_every_stage_fails_are_reached_from_zero_load() {
 /// 10 × 0.07, F = 1, from α = 2 to −2, κ(W) = 1.0e8; `auto` carries it in extended
 /// precision, where its path agrees with the reference, 428 events). In double a join
 /// where the usual thresholds found no continuation used to take the first widening that
-/// found several
-/// (a last resort since removed), and the path ended as a closed loop at α = 0.025 after
-/// 268 events, while the reference's goes on to −2. (Found by a sweep of 2,000 traces of
-/// this file's families, half of them in double, the only one that reached that branch.)
+/// found several (a last resort since removed), and the path ended as a closed loop at
+/// α = 0.025 after 268 events, while the reference's goes on to −2. (Found by a sweep of
+/// 2,000 traces of this file's families, half of them in double, the only one that
+/// reached that branch.)
 /// Without that branch it returned an error ("node 59 fits no class" at α = 0.029, after
 /// 266 events): a slipping node's λν reached 0 with its λt (−2.2e-12) above open's
 /// threshold (1.5e-12, F = 1) by rounding, and the first retry, at the data's
