@@ -121,12 +121,14 @@ impl Load {
     /// far rounding moves f where the load passes through (near) zero. It takes them as
     /// large as the load's change along the current piece (from the last transition point,
     /// or the start; or over the load's own α length ‖q‖/‖q'‖ where that is longer; never
-    /// more than over the window), and a guard within their rounding is at zero. Where the
-    /// load at a transition is far smaller than that change, transitions that lie closer
-    /// together can be merged into one or moved, without an error: f = 1e-8 f0 + φ(α) f1 (φ
-    /// = α + 0.2 sin 2α) traced from α = ±1 through φ = 0 had a wrong first transition near
-    /// φ = 0 in 2 of 80 traces on finite-element meshes (none of 80 on random problems),
-    /// and 1e-10 f0 + φ(α) f1 wrong events on 5 of 160 traces. A basis load
+    /// more than over the window; and at least over 64 roundings of α over `zero_tol`, as f
+    /// computed from α is known to no better than one rounding of α, |f'| ε |α|), and a
+    /// guard within their rounding is at zero. Where the load at a transition is far
+    /// smaller than that change, transitions that lie closer together can be merged into
+    /// one or moved, without an error: f = 1e-8 f0 + φ(α) f1 (φ = α + 0.2 sin 2α) traced
+    /// from α = ±1 through φ = 0 had a wrong first transition near φ = 0 in 2 of 80 traces
+    /// on finite-element meshes (none of 80 on random problems), and 1e-10 f0 + φ(α) f1
+    /// wrong events on 5 of 160 traces. A basis load
     /// ([`Load::basis`]) has exact terms and traced all of them: give the load so where it
     /// is a sum of fixed vectors. On an ill-conditioned body the rounding of each entry of
     /// f(α) (ε |f|, fresh at every α) moves the solution by up to the piece's conditioning
@@ -160,6 +162,11 @@ impl Load {
             Load::General { n, .. } => *n,
         }
     }
+}
+
+/// The step of a general load's central differences at `alpha`, `ε^{1/3} max(1, |α|)`.
+fn difference_step(alpha: f64) -> f64 {
+    f64::EPSILON.cbrt() * alpha.abs().max(1.0)
 }
 
 fn check_finite(name: &str, v: &[f64]) -> Result<()> {
@@ -769,6 +776,12 @@ impl BoundLoad {
             .then_some((&self.weights[..], &self.dweights[..]))
     }
 
+    /// For a general load without a derivative: the step of its central differences at
+    /// `alpha`, `ε^{1/3} max(1, |α|)`. None for other loads.
+    pub(crate) fn difference_step(&self, alpha: f64) -> Option<f64> {
+        matches!(self.load, Load::General { df: None, .. }).then(|| difference_step(alpha))
+    }
+
     /// True when `f` (hence `q`) is affine in α.
     pub(crate) fn is_affine(&self) -> bool {
         matches!(self.load, Load::Affine { .. })
@@ -946,7 +959,7 @@ impl BoundLoad {
                         (d, None, 1.0)
                     }
                     None => {
-                        let h = f64::EPSILON.cbrt() * alpha.abs().max(1.0);
+                        let h = difference_step(alpha);
                         let mut fp = take(&mut self.pool, n);
                         let mut fm = take(&mut self.pool, n);
                         call_vector(f, alpha + h, &mut fp, "f")?;

@@ -1195,6 +1195,10 @@ impl Path {
                                 "at |alpha| = {:e} one rounding of alpha moves this guard by {by_alpha:e}, more than its threshold, so a load (or its weights) computed from alpha is too inaccurate here, whatever the solves: write the load on an alpha axis centred on the window (alpha - alpha_start), or raise zero_tol",
                                 pb.alpha.abs()
                             )
+                        } else if let Some(h) = self.load.difference_step(pb.alpha) {
+                            format!(
+                                "this load has no derivative, and its slopes come from central differences with the step h = {h:e} (eps^(1/3) max(1, |alpha|)), too long where the load changes faster (or the solves of the load are too inaccurate here, cond · eps): give the load's derivative, or write the load on an alpha axis centred on the window (alpha - alpha_start)"
+                            )
                         } else if self.load.basis_vectors().is_some() {
                             "the solves along this piece (cond · eps) or the load's weights are too inaccurate here: build the problem with extended precision, or raise zero_tol".to_string()
                         } else {

@@ -441,6 +441,19 @@ const RESOLVED_APART: f64 = 1e-10;
 /// terms use the own length itself (a factor of 1, see [`Path::term_rows`]).
 const FAR_WINDOW: f64 = 1e3;
 
+/// How many roundings of α a general load's thresholds cover: its terms
+/// ([`Path::term_rows`]) count its change over at least `ALPHA_ROUNDINGS ε |α| /
+/// zero_tol`, so that its thresholds are at least `ALPHA_ROUNDINGS ε |α| r0 |q'_k|`. A
+/// load computed from α is known to no better than one rounding of α, `|q'| ε |α|`,
+/// whatever its own arithmetic (an oscillating `φ(α) = s − A cos ω(α − α0)` at ω = 118,
+/// α = 27 moves by 7e-13 of A per rounding), and where that exceeded the thresholds,
+/// solutions at points a rounding apart disagreed by more than they: on symmetric bodies
+/// under such loads (ω 30–300, α0 up to ±100), 100 of 742 traces stopped with "node k
+/// fits no class" at |α| 27–96, where the same loads near α = 0 passed. With 16
+/// roundings 1 of them still did, with 64 none (and every trace agreed with the
+/// reference's events).
+const ALPHA_ROUNDINGS: f64 = 64.0;
+
 /// Most pieces the start point is refined on in extended precision before its classes
 /// settle ([`Path::start_on_its_piece`]); one or two in every case seen (an active-set
 /// iteration from the fixed-α solver's classes, which differ from the refined point's in
@@ -1140,8 +1153,9 @@ impl Path {
     /// ([`BoundLoad::term_rate_rows`]: a point's q and λ on the piece carry that change's
     /// rounding, which does not vanish where the weights do); for a general load, whose
     /// terms are not known, `|q_k| + L |q'_k|` (the change of q over an α length L: the
-    /// window's, but no more than the point's own, see [`Self::load_span`]). With whether
-    /// they are estimated so.
+    /// window's, but no more than the point's own, see [`Self::load_span`]; and at least
+    /// [`ALPHA_ROUNDINGS`] roundings of α over `zero_tol`, see there). With whether they
+    /// are estimated so.
     ///
     /// The estimate cannot tell a load whose terms cancel (where it passes through zero)
     /// from one that is small by itself, and it errs to the larger: thresholds too large
@@ -1176,7 +1190,9 @@ impl Path {
                 (rows, false)
             }
             None => {
-                let span = self.load_span(pt, 1.0, from);
+                let span = self
+                    .load_span(pt, 1.0, from)
+                    .max(ALPHA_ROUNDINGS * f64::EPSILON / self.opts.zero_tol * pt.alpha.abs());
                 let rows =
                     pt.q.iter()
                         .zip(&pt.dq)
