@@ -1263,12 +1263,14 @@ fricont_status fricont_path_new_basis(struct fricont_problem *problem,
  * rounding moves f where the load passes through (near) zero. It takes them as large as
  * the load's change along the current piece (from the last transition point, or the
  * start; or over the load's own α length ‖q‖/‖q'‖ where that is longer; never more than
- * over the window), and a guard within their rounding is at zero. Where the load at a
- * transition is far smaller than that change, transitions that lie closer together can
- * be merged into one or moved, without an error: f = 1e-8 f0 + φ(α) f1 (φ = α + 0.2 sin
- * 2α) traced from α = ±1 through φ = 0 had a wrong first transition near φ = 0 in 2 of
- * 80 traces on finite-element meshes (none of 80 on random problems), and 1e-10 f0 +
- * φ(α) f1 wrong events on 5 of 160 traces. A basis load (`fricont_path_new_basis`) has
+ * over the window; and at least over 64 roundings of α over zero_tol, as f computed from
+ * α is known to no better than one rounding of α, |f'| ε |α|), and a guard within their
+ * rounding is at zero. Where the load at a transition is far smaller than that change,
+ * transitions that lie closer together can be merged into one or moved, without an
+ * error: f = 1e-8 f0 + φ(α) f1 (φ = α + 0.2 sin 2α) traced from α = ±1 through φ = 0
+ * had a wrong first transition near φ = 0 in 2 of 80 traces on finite-element meshes
+ * (none of 80 on random problems), and 1e-10 f0 + φ(α) f1 wrong events on 5 of 160
+ * traces. A basis load (`fricont_path_new_basis`) has
  * exact terms and traced all of them: give the load so where it is a sum of fixed
  * vectors. On an ill-conditioned body the rounding of each entry of f(α) (ε |f|, fresh
  * at every α) moves the solution by up to the piece's conditioning times that, also
