@@ -570,9 +570,9 @@ fn curved_bodies_under_a_load_oscillating_through_zero_walk_the_affine_path() {
 /// [`walk_the_affine_path`]). One rounding of α there moves φ by up to 2ω|α|ε, 1e-12 to
 /// 7e-12, more than the thresholds of guards near zero: solutions a rounding apart
 /// disagreed by more than those. In the sweep that found these three (742 such loads on
-/// other windows, 100 of which stopped, none near α = 0) each stopped with "node k fits
-/// no class", and so did this test's first walk without the change. A general load's
-/// thresholds now cover 64 roundings of α (`ALPHA_ROUNDINGS`).
+/// other windows, 100 of which stopped, none below |α| = 8.6) each stopped with "node k
+/// fits no class", and so did this test's first walk without the change. A general
+/// load's thresholds now cover 64 roundings of α (`ALPHA_ROUNDINGS`).
 #[test]
 fn symmetric_bodies_under_a_fast_general_load_far_out_walk_the_affine_path() {
     for (seed, nx, ny, f, omega, a0) in [

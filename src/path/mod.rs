@@ -448,9 +448,9 @@ const FAR_WINDOW: f64 = 1e3;
 /// whatever its own arithmetic (an oscillating `φ(α) = s − A cos ω(α − α0)` at ω = 118,
 /// α = 27 moves by 7e-13 of A per rounding), and where that exceeded the thresholds,
 /// solutions at points a rounding apart disagreed by more than they: on symmetric bodies
-/// under such loads (ω 30–300, α0 up to ±100), 100 of 742 traces stopped with "node k
-/// fits no class" at |α| 27–96, where the same loads near α = 0 passed. With 16
-/// roundings 1 of them still did, with 64 none (and every trace agreed with the
+/// under such loads (ω 30–300, α0 up to ±100), 100 of 742 traces stopped, 98 with "node
+/// k fits no class", at |α| 8.6–99 (most beyond 27); as basis loads none did. With 16
+/// roundings 1 of them still stopped, with 64 none (and every trace agreed with the
 /// reference's events).
 const ALPHA_ROUNDINGS: f64 = 64.0;
 
