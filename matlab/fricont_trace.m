@@ -67,9 +67,10 @@ function res = fricont_trace(A, N, T, f0, f1, F, window, opts)
 %             classes.
 %     start   the start point (alpha, residual, u, lambda_n, lambda_t, classes).
 %     start_route  how the start point was reached: 'solved' (the fixed-alpha solver),
-%             or, where it failed, 'nearby' (a path from a nearby alpha), 'zero_load'
-%             (the path of tau * f(alpha) from tau = 0) or 'open' (the path from a load
-%             that holds every node open); see fricont_path_start in fricont.h.
+%             or, where it failed, 'zero_load' (the path of tau * f(alpha) from
+%             tau = 0), 'open' (the path from a load that holds every node open) or,
+%             where those failed too, 'nearby' (a path from a nearby alpha); see
+%             fricont_path_start in fricont.h.
 %     end_reason  'window', 'max_steps', 'closed_loop', 'bifurcation', 'failed' or
 %             'stopped' (by the monitor).
 %     branches  struct array (classes, direction, orientation_preserving): where the

@@ -333,29 +333,35 @@ fn in_double_against(ctx: &str, case: &common::Case, exact: &common::reference::
     }
 }
 
-/// Starts where the fixed-α solver stalls are reached by the path from a nearby α, and
+/// Starts where the fixed-α solver stalls are reached by the rays of `Path::start`, and
 /// `start_route` says so:
 /// * 318 × 1 elements on 10 × 0.19, F = 5, from α = −2 (found by a sweep of 400 slender
-///   strips, the only one of them that needed it): the start and the whole path must
-///   agree with the independent reference tracer (which checks that the start's piece
-///   reproduces fricont's λ) to 1e-9;
+///   strips, the only one of them that needed a fallback): the ray from zero load cannot
+///   leave τ = 0 (its gaps are zero), the ray from every node open reaches the start. The
+///   start and the whole path must agree with the independent reference tracer (which
+///   checks that the start's piece reproduces fricont's λ) to 1e-9;
 /// * 400 × 4 elements on 10 × 0.1, F = 5, from α = −2, in double: every stage failed, its
-///   friction continuation at 0.875 F, and so on 1e-3 around it. Its start must agree with
-///   the reference's to κ(W) ε, what double allows. With the window's far end at 1e12 the
-///   same start and events follow (the nearby α were 1e-3 … 1e-1 of the window's length
-///   away, 1e9 and more: every one failed, and so did the start). In extended precision
-///   (which `auto` chooses for this strip) the solver's stalled iterate is solved again on
-///   its piece in double-double, and the solver now reaches the start itself; that path
-///   agrees with the reference to 1e-9.
+///   friction continuation at 0.875 F, and so on 1e-3 around it; the ray from zero load
+///   reaches the start. It must agree with the reference's to κ(W) ε, what double allows.
+///   With the window's far end at 1e12 the same start and events follow. In extended
+///   precision (which `auto` chooses for this strip) the solver's stalled iterate is
+///   solved again on its piece in double-double, and the solver reaches the start itself;
+///   that path agrees with the reference to 1e-9.
 ///
-/// Before the nearby starts, `Path::start` returned `SolveFailed` on both.
+/// Before the fallbacks, `Path::start` returned `SolveFailed` on both. Until the rays
+/// came before the nearby α, both starts came from a nearby α (the path from −1.996
+/// reached −2 on the same piece), the far window's too once the nearby α were taken
+/// within the load's own α scale (1e-3 … 1e-1 of the window's length were 1e9 away and
+/// more, and every one failed). The nearby start is now the last fallback, covered by the
+/// switch of a unit test (`src/path/mod.rs`).
 #[test]
-fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
+fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_ray() {
     let mut short = common::fe_strip(82, 318, 1, 5.0, 10.0, 1.906413598103785e-1);
     (short.a0, short.a1) = (-2.0, 2.0);
+    assert!(short.data.gap.iter().all(|&g| g == 0.0));
     let c = against_the_reference("seed 82, 318 × 1 elements on 10 × 0.19", &short);
     assert!(c.fricont.len() >= 500, "{} events", c.fricont.len());
-    assert_eq!(c.fricont_route, fricont::StartRoute::Nearby);
+    assert_eq!(c.fricont_route, fricont::StartRoute::Open);
 
     let mut case = common::fe_strip(3, 400, 4, 5.0, 10.0, 0.1);
     (case.a0, case.a1) = (-2.0, 2.0);
@@ -374,7 +380,7 @@ fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
     let c = common::reference::compare_case(&case, double.clone(), 1e-9);
     assert_eq!(
         c.fricont_route,
-        fricont::StartRoute::Nearby,
+        fricont::StartRoute::ZeroLoad,
         "{ctx}, in double"
     );
     let kappa_eps = double.w_condition_estimate() * f64::EPSILON;
@@ -387,7 +393,7 @@ fn a_start_where_the_fixed_alpha_solver_stalls_comes_from_a_nearby_alpha() {
     let mut path =
         fricont::Path::new(double, load, fricont::PathOptions::window(-2.0, 1e12)).unwrap();
     path.start(-2.0, None).expect("start with a far window end");
-    assert_eq!(path.start_route(), Some(fricont::StartRoute::Nearby));
+    assert_eq!(path.start_route(), Some(fricont::StartRoute::ZeroLoad));
     while path.events().last().is_none_or(|e| e.alpha <= 2.0) {
         if matches!(path.step().unwrap(), fricont::StepOutcome::End(_)) {
             break;

@@ -251,10 +251,11 @@ class Path:
         #: The failure message when ``end_reason == "failed"``.
         self.end_message: Optional[str] = message
         #: How the start point was reached: "solved" (the fixed-alpha solver at the
-        #: start's alpha), or where it failed, "nearby" (a path traced from a nearby
-        #: alpha), "zero_load" (the path of the load tau f(alpha) from tau = 0) or "open"
-        #: (the path from a load that holds every node open); "none" when the path never
-        #: started. Every route ends in the same check of the start point.
+        #: start's alpha), or where it failed, "zero_load" (the path of the load
+        #: tau f(alpha) from tau = 0), "open" (the path from a load that holds every node
+        #: open) or, where those failed too, "nearby" (a path traced from a nearby alpha);
+        #: "none" when the path never started. Every route ends in the same check of the
+        #: start point.
         self.start_route: str = core.start_route() or "none"
         #: The candidate continuations (:class:`Branch`) at the last transition point,
         #: 0-based as ``choose_branch`` takes them: empty unless it was a bifurcation
@@ -518,11 +519,15 @@ class Problem:
         path; it then goes toward ``window[1]``, through folds, until alpha leaves the
         window. Where W is carried in extended precision, a stage of that solve that
         stalls has its last iterate solved again on its piece in double-double until the
-        classes settle. Where that solve fails at ``alpha_start``, it solves at a nearby alpha
-        (1e-3, 1e-2, 1e-1 of the window's length away, or of a thousand times the load's
-        own alpha scale ||q|| / ||q'|| where that is shorter; inside the window) and the path
-        from there is traced back to ``alpha_start``: the point it reaches is the start
-        (SolveError only where none leads there). ``max_steps`` bounds the number of transition points (default 10 000).
+        classes settle. Where that solve fails at ``alpha_start``, the start is the point at
+        tau = 1 of the path of the load tau f(alpha_start) from zero load (tau = 0), or
+        where that path cannot leave tau = 0 (every gap zero), from a load that holds every
+        node open; where neither gets there, it solves at a nearby alpha (1e-3, 1e-2, 1e-1
+        of the window's length away, or of a thousand times the load's own alpha scale
+        ||q|| / ||q'|| where that is shorter; inside the window) and the path from there is
+        traced back to ``alpha_start``: the point it reaches is the start (SolveError only
+        where none leads there). ``path.start_route`` says which of these it was.
+        ``max_steps`` bounds the number of transition points (default 10 000).
 
         ``guess`` (None or 2p values: lambda_n of the p nodes, then lambda_t; force units,
         lambda_n <= 0 compressive) is where the fixed-alpha solve starts instead of zero

@@ -310,10 +310,11 @@ impl fricont_end_reason {
 pub enum fricont_start_route {
     /// The fixed-α solver at α, from the guess or from zero forces.
     FRICONT_START_SOLVED = 0,
-    /// The solver failed at α; a path traced from a nearby α reached it.
+    /// The solver failed at α, and so did the paths of `FRICONT_START_ZERO_LOAD` and
+    /// `FRICONT_START_OPEN`; a path traced from a nearby α reached it.
     FRICONT_START_NEARBY = 1,
-    /// The solver failed at α and near it; the path of the load `tau f(alpha)` from zero
-    /// load (tau = 0) reached it at tau = 1.
+    /// The solver failed at α; the path of the load `tau f(alpha)` from zero load
+    /// (tau = 0) reached it at tau = 1.
     FRICONT_START_ZERO_LOAD = 2,
     /// As `FRICONT_START_ZERO_LOAD`, but that path could not leave tau = 0 (every gap
     /// zero); the path from a load that holds every node open reached it.

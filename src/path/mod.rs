@@ -118,10 +118,12 @@ impl EndReason {
 pub enum StartRoute {
     /// The fixed-α solver at α, from the guess or from zero forces.
     Solved,
-    /// The solver failed at α; a path traced from a nearby α reached it.
+    /// The solver failed at α, and so did the paths from zero load and from every node
+    /// open ([`StartRoute::ZeroLoad`], [`StartRoute::Open`]); a path traced from a nearby
+    /// α reached it.
     Nearby,
-    /// The solver failed at α and near it; the path of the load `τ f(α)` from zero load
-    /// (τ = 0) reached it at τ = 1.
+    /// The solver failed at α; the path of the load `τ f(α)` from zero load (τ = 0)
+    /// reached it at τ = 1.
     ZeroLoad,
     /// As [`StartRoute::ZeroLoad`], but that ray could not leave τ = 0 (every gap zero);
     /// the ray from a load that holds every node open reached it.
@@ -1751,30 +1753,31 @@ impl Path {
     /// stage of the fixed-α solver that stalls has its last iterate solved again on its
     /// piece in double-double until the classes settle (an exact solution of `H = 0` to
     /// that precision, reached where no double iterate reaches 1e-12 on an ill-conditioned W).
-    /// Where the fixed-α solver fails at `alpha`, it solves at a nearby α instead (1e-3,
-    /// 1e-2, 1e-1 of the window's length away, or of 1e3 times the load's own α scale at
-    /// `alpha`, `max(‖q‖∞ / ‖q'‖∞, |alpha − alpha_start|)`, where that is shorter, toward
+    /// Where the fixed-α solver fails at `alpha`, the start is reached from zero load: the
+    /// path of the same problem under the load `τ f(alpha)` is traced from τ = 0 (zero
+    /// forces, where every gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1
+    /// is the start; where that path does not get there (it cannot leave τ = 0 where every
+    /// gap is zero), the same ray from a load that holds every node open at τ = 0 (on the
+    /// equilibrated W in double; its point at τ = 1 is the start's guess).
+    /// Where that fails too, it solves at a nearby α instead (1e-3, 1e-2, 1e-1 of the
+    /// window's length away, or of 1e3 times the load's own α scale at `alpha`,
+    /// `max(‖q‖∞ / ‖q'‖∞, |alpha − alpha_start|)`, where that is shorter, toward
     /// `alpha_end` first) and traces the path from there back to `alpha`: its point there
-    /// is the start.
-    /// Where that fails too, the start is reached from zero load: the path of the same
-    /// problem under the load `τ f(alpha)` is traced from τ = 0 (zero forces, where every
-    /// gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1 is the start; where
-    /// that path does not get there (it cannot leave τ = 0 where every gap is zero), the
-    /// same ray from a load that holds every node open at τ = 0 (on the equilibrated W
-    /// in double; its point at τ = 1 is the start's guess). [`Path::start_route`] says
-    /// which of these reached the start.
+    /// is the start. [`Path::start_route`] says which of these reached the start.
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails (also from every nearby α and from zero load), the load fails, no piece
     /// leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
+        // The rays before the nearby α: each nearby α is a solve of its own, which fails
+        // as slowly as the one at `alpha` where it fails too (see `start_from_zero_load`).
         let r = match self.start_solved(alpha, guess) {
-            Err(Error::SolveFailed { message, .. }) => self
-                .start_from_nearby(alpha, message)
-                .map(|()| StartRoute::Nearby),
+            Err(Error::SolveFailed { message, .. }) => self.start_from_zero_load(alpha, message),
             r => r.map(|()| StartRoute::Solved),
         };
         let route = match r {
-            Err(Error::SolveFailed { message, .. }) => self.start_from_zero_load(alpha, message)?,
+            Err(Error::SolveFailed { message, .. }) => self
+                .start_from_nearby(alpha, message)
+                .map(|()| StartRoute::Nearby)?,
             r => r?,
         };
         if let Some(tr) = self.trace.as_mut() {
@@ -1783,10 +1786,15 @@ impl Path {
         Ok(())
     }
 
-    /// The fixed-α solver can fail where the path from nearby α fails as well: on a body
-    /// in a corner (p = 35, F = 5) and on a curved foundation (p = 24, F = 5) every stage
-    /// stalled at α = 4 (residuals 2e-4 to 9e-2) and at every nearby α, while the path of
-    /// the load `τ f(4)` from τ = 0 reached τ = 1 in 9 and 13 transitions (two folds each).
+    /// The fixed-α solver's first fallback where it fails at `alpha`. It can fail near
+    /// `alpha` as well: on a body in a corner (p = 35, F = 5) and on a curved foundation
+    /// (p = 24, F = 5) every stage stalled at α = 4 (residuals 2e-4 to 9e-2) and at every
+    /// nearby α, while the path of the load `τ f(4)` from τ = 0 reached τ = 1 in 9 and 13
+    /// transitions (two folds each). And a nearby α is a solve of its own, which costs as
+    /// much as the one that failed where it fails too: on a strip with p = 1500 and
+    /// F = 5 (`fe_strip` seed 3 of the tests, 1500 × 2 elements) every stage failed at
+    /// α = −2 in 64 s and at three nearby α in 54–64 s each, while this ray reached the
+    /// start in 22–25 s (59 transitions). So the rays come first, the nearby α after them.
     /// At τ = 0 the load is zero, and where every gap is ≥ 0 the forces are zero: a start
     /// the solver finds at once, and the only solution there (with no load, forces that
     /// satisfy the contact and friction conditions do no positive work, `λᵀ W λ ≤ 0`, and
@@ -1799,6 +1807,13 @@ impl Path {
     /// node open ([`Self::ray_from_open`]); where neither does: `SolveFailed` with `failed`
     /// and where each ended. Ok: which ray reached the start.
     fn start_from_zero_load(&mut self, alpha: f64, failed: String) -> Result<StartRoute> {
+        #[cfg(test)]
+        if tests::REFUSE_RAYS.get() {
+            return Err(Error::SolveFailed {
+                alpha,
+                message: format!("{failed}; the rays refused by the test switch"),
+            });
+        }
         let f = self.load.force(alpha)?;
         let ray = Load::affine(vec![0.0; f.len()], f)?;
         let end = match self.ray_end(self.problem.clone(), ray)? {
@@ -1888,17 +1903,19 @@ impl Path {
         })
     }
 
-    /// The fixed-α solver can stall where the problem has a regular solution: on a slender
-    /// strip (400 × 4 elements on 10 × 0.1, F = 5) every stage failed at α = −2 and on
-    /// 1e-3 around it, while at α = −1.996 it converged and the path from there reached
-    /// −2 on the same piece. Then the start is solved at α ± δ (δ = 1e-3, 1e-2, 1e-1 of the
-    /// window's length, or of the shorter [`Self::load_span`] at α: a window with a far
-    /// end, [−2, 1e12], probed 1e9 away and failed; toward `alpha_end` first, inside the
-    /// window) and the path traced from there to α (a window of its own; its events are
-    /// dropped); the point it reaches is the start's guess, kept by the solver as it
-    /// solves the problem. Where none leads
-    /// to α: `SolveFailed` with the solver's message `failed` at α and what the nearby
-    /// starts reached.
+    /// The last fallback of [`Self::start`], where the fixed-α solver and the rays of
+    /// [`Self::start_from_zero_load`] fail. The solver can stall where the problem has a
+    /// regular solution: on a slender strip (400 × 4 elements on 10 × 0.1, F = 5, in
+    /// double) every stage failed at α = −2 and on 1e-3 around it, while at α = −1.996 it
+    /// converged and the path from there reached −2 on the same piece (the ray from zero
+    /// load reaches that start too, and comes first now). Here the start is solved at
+    /// α ± δ (δ = 1e-3, 1e-2, 1e-1 of the window's length, or of the shorter
+    /// [`Self::load_span`] at α: a window with a far end, [−2, 1e12], probed 1e9 away and
+    /// failed; toward `alpha_end` first, inside the window) and the path traced from there
+    /// to α (a window of its own; its events are dropped); the point it reaches is the
+    /// start's guess, kept by the solver as it solves the problem. Where none leads to α:
+    /// `SolveFailed` with the message `failed` (the solver's at α and the rays') and what
+    /// the nearby starts reached.
     fn start_from_nearby(&mut self, alpha: f64, failed: String) -> Result<()> {
         let opts = self.opts.clone();
         let (lo, hi) = self.window();
@@ -2488,14 +2505,19 @@ mod tests {
         /// as where every stage stalls at the start's α but not near it.
         pub(super) static REFUSE_START_AT: std::cell::Cell<Option<f64>> =
             const { std::cell::Cell::new(None) };
+        /// Test switch: the rays of `start_from_zero_load` fail at once.
+        pub(super) static REFUSE_RAYS: std::cell::Cell<bool> =
+            const { std::cell::Cell::new(false) };
     }
 
     /// The block on a foundation, solved by hand: A = diag(2, 1), N = [1, 0], T = [0, 1],
-    /// F = 1/2, f(α) = (1, 0) + α (0, 1). At α = 0 the node sticks with λ = (−1, 0); it
-    /// slips in +t from α = 1/2 (λt reaches F λν = −1/2). Where the solver fails at the
-    /// start's α, the start comes from a nearby α, and says so; the same start and event.
+    /// F = 1/2, gap 0, f(α) = (1, 0) + α (0, 1). At α ∈ [0, 1/2] the node sticks with
+    /// λ = (−1, −α); it slips in +t from α = 1/2 (λt reaches F λν = −1/2). Started at
+    /// α = 1/4: where the solver fails there, the start comes from the ray `τ f(1/4)` from
+    /// zero load (along which the node sticks, λ = −τ (1, 1/4), from τ = 0 on); where the
+    /// rays fail too, from a nearby α. Each says so; the same start and event.
     #[test]
-    fn a_start_the_solver_misses_comes_from_a_nearby_alpha_and_says_so() {
+    fn a_start_the_solver_misses_comes_from_a_ray_or_a_nearby_alpha_and_says_so() {
         let csr = |r, c, v: &[f64]| CsrMatrix::from_dense(r, c, v).unwrap();
         let problem = Arc::new(
             ProblemBuilder::new(
@@ -2508,21 +2530,28 @@ mod tests {
             .build()
             .unwrap(),
         );
-        for (refuse, route) in [(None, StartRoute::Solved), (Some(0.0), StartRoute::Nearby)] {
+        for (refuse, rays, route) in [
+            (None, true, StartRoute::Solved),
+            (Some(0.25), false, StartRoute::ZeroLoad),
+            (Some(0.25), true, StartRoute::Nearby),
+        ] {
             let load = Load::affine(vec![1.0, 0.0], vec![0.0, 1.0]).unwrap();
-            let mut path = Path::new(problem.clone(), load, PathOptions::window(0.0, 2.0)).unwrap();
+            let mut path =
+                Path::new(problem.clone(), load, PathOptions::window(0.25, 2.0)).unwrap();
             REFUSE_START_AT.set(refuse);
-            let started = path.start(0.0, None);
+            REFUSE_RAYS.set(rays);
+            let started = path.start(0.25, None);
             REFUSE_START_AT.set(None);
+            REFUSE_RAYS.set(false);
             started.unwrap();
             assert_eq!(path.start_route(), Some(route));
             let st = path.start_state().unwrap();
             assert!(
-                st.alpha == 0.0 && st.classes == [Class::Stick],
+                st.alpha == 0.25 && st.classes == [Class::Stick],
                 "{route:?}: {st:?}"
             );
             assert!(
-                (st.lambda_n[0] + 1.0).abs() <= 1e-15 && st.lambda_t[0].abs() <= 1e-15,
+                (st.lambda_n[0] + 1.0).abs() <= 1e-15 && (st.lambda_t[0] + 0.25).abs() <= 1e-15,
                 "{route:?}: λ = ({}, {})",
                 st.lambda_n[0],
                 st.lambda_t[0]
