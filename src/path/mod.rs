@@ -1671,7 +1671,17 @@ impl Path {
         // Unit tangent in scaled coordinates, (y/S, 1/A) normalised.
         let mut t: Vec<f64> = y.iter().map(|v| v / scales.force).collect();
         t.push(1.0 / scales.alpha);
-        let norm = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let mut norm = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if norm == f64::INFINITY {
+            // The same direction times A, (A y/S, 1), where (1/A)² overflows: at zero load
+            // the force scale S is its floor, 1e-300, and A = S / (r ‖q'‖) with it (the
+            // start of `start_from_zero_load`'s ray, every node open). Its tangent fell back
+            // to a full-pivoting LU of the whole Jacobian, twice, 15 s of the ray's 22 s on
+            // a strip with p = 1500.
+            let k = scales.alpha / scales.force;
+            t = y.iter().map(|v| v * k).chain([1.0]).collect();
+            norm = t.iter().map(|v| v * v).sum::<f64>().sqrt();
+        }
         if !(norm.is_finite() && norm > 0.0) || t[m] / norm <= 1e-13 {
             return None;
         }
@@ -1794,7 +1804,7 @@ impl Path {
     /// much as the one that failed where it fails too: on a strip with p = 1500 and
     /// F = 5 (`fe_strip` seed 3 of the tests, 1500 × 2 elements) every stage failed at
     /// α = −2 in 64 s and at three nearby α in 54–64 s each, while this ray reached the
-    /// start in 22–25 s (59 transitions). So the rays come first, the nearby α after them.
+    /// start in 1.3 s (59 transitions). So the rays come first, the nearby α after them.
     /// At τ = 0 the load is zero, and where every gap is ≥ 0 the forces are zero: a start
     /// the solver finds at once, and the only solution there (with no load, forces that
     /// satisfy the contact and friction conditions do no positive work, `λᵀ W λ ≤ 0`, and
@@ -2508,6 +2518,59 @@ mod tests {
         /// Test switch: the rays of `start_from_zero_load` fail at once.
         pub(super) static REFUSE_RAYS: std::cell::Cell<bool> =
             const { std::cell::Cell::new(false) };
+    }
+
+    /// The block of the next test with a gap of 0.1 under the load ray f(α) = α (1, 1/4),
+    /// as `start_from_zero_load` traces it: at α = 0 the load and the forces are zero and
+    /// the node is open; its piece's tangent is λ' = 0 (t = (0, 0, t_α), t_α > 0). The
+    /// force scale there is its floor, 1e-300, and (1/A)² overflowed in the tangent's norm:
+    /// it came from a full-pivoting LU of the whole Jacobian instead of the updated
+    /// factorisation (15 s of the 22 s ray at p = 1500). By hand, u₁ = α/2 reaches the gap
+    /// at α = 0.2, where u₂ = α/4 > 0: the node slips (λν = 0.2 − α, λt = F λν) until
+    /// u₂ = α/4 + λt = 0.1 − α/4 reaches 0 at α = 0.4, and sticks from there on
+    /// (λ = (0.2 − α, −α/4), within the cone).
+    #[test]
+    fn the_tangent_at_zero_load_comes_from_the_updated_factorisation() {
+        let csr = |r, c, v: &[f64]| CsrMatrix::from_dense(r, c, v).unwrap();
+        let problem = Arc::new(
+            ProblemBuilder::new(
+                csr(2, 2, &[2.0, 0.0, 0.0, 1.0]),
+                Storage::Full,
+                csr(1, 2, &[1.0, 0.0]),
+                csr(1, 2, &[0.0, 1.0]),
+            )
+            .friction_uniform(0.5)
+            .gap(vec![0.1])
+            .build()
+            .unwrap(),
+        );
+        let load = Load::affine(vec![0.0, 0.0], vec![1.0, 0.25]).unwrap();
+        let mut path = Path::new(problem, load, PathOptions::window(0.0, 1.0)).unwrap();
+        path.start(0.0, None).unwrap();
+        assert_eq!(path.start_route(), Some(StartRoute::Solved));
+        let pt = path.point_at(vec![0.0; 2], 0.0).unwrap();
+        let scale = path.force_scale(&pt);
+        assert_eq!(scale, 1e-300);
+        let tan = path.tangent(&[Class::Open], &pt, scale).unwrap();
+        assert!(
+            matches!(tan.lu, PieceSolver::Updated(_)),
+            "a full-pivoting LU"
+        );
+        assert!(
+            tan.t[0] == 0.0 && tan.t[1] == 0.0 && tan.t[2] > 0.0 && tan.t[2].is_finite(),
+            "t = {:?}",
+            tan.t
+        );
+        assert_eq!(path.run().unwrap(), EndReason::Window);
+        let ev = path.events();
+        assert_eq!(ev.len(), 2, "{ev:?}");
+        for (e, (alpha, from, to)) in ev.iter().zip([
+            (0.2, Class::Open, Class::SlipPlus),
+            (0.4, Class::SlipPlus, Class::Stick),
+        ]) {
+            assert!((e.alpha - alpha).abs() <= 1e-15, "{e:?}");
+            assert_eq!((e.from, e.to), (from, to));
+        }
     }
 
     /// The block on a foundation, solved by hand: A = diag(2, 1), N = [1, 0], T = [0, 1],
