@@ -480,16 +480,16 @@ fn block_gauss_seidel(
 /// beyond double: it solves the iterate's piece again in double-double until the classes
 /// settle (an exact solution of `H = 0` to that precision), which reaches solutions that
 /// no double iterate reaches on an ill-conditioned W (κ(W) = 2.7e12: every stage stalled
-/// at residuals of 1e-8 to 4e-11, also without friction).
+/// at residuals of 1e-8 to 4e-11, also without friction). `stages`: which of them run.
 pub(crate) fn solve_fixed_alpha(
     problem: &crate::problem::Problem,
     qg: &[f64],
     guess: Option<&[f64]>,
     alpha: f64,
+    stages: Stages,
     polish: Polish<'_>,
 ) -> Result<Vec<f64>> {
-    solve_with_frozen(problem, qg, guess, alpha, None, Stages::All, None, polish)
-        .map(|(lam, _)| lam)
+    solve_with_frozen(problem, qg, guess, alpha, None, stages, None, polish).map(|(lam, _)| lam)
 }
 
 /// Which stages of [`solve_with_frozen`] run.
@@ -498,6 +498,9 @@ pub(crate) enum Stages {
     /// Newton, the active-set iteration, Newton again, and 20 rounds of Gauss–Seidel
     /// sweeps and Newton (a first pass: where these fail, so does the solve).
     First,
+    /// [`Stages::First`] and the continuation in the friction coefficients: all but the
+    /// long runs, which cost most where they fail too.
+    NoLongRuns,
     /// Every stage, down to the continuation in the friction coefficients, the long
     /// Gauss–Seidel run and the restarts.
     All,
@@ -614,6 +617,12 @@ fn solve_stages(
     match friction_continuation(c, w, w_row_sums, qg, fr) {
         Ok(lam) => return Ok(lam),
         Err(msg) => notes.push(msg),
+    }
+    if stages == Stages::NoLongRuns {
+        return Err(Error::SolveFailed {
+            alpha,
+            message: notes.join("; "),
+        });
     }
     let lam_gs = block_gauss_seidel(c, w, qg, lam, 20_000, fr);
     let (lam, ok, msg) = newton(pieces, qg, lam_gs, 200, fr);

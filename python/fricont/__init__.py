@@ -519,7 +519,8 @@ class Problem:
         path; it then goes toward ``window[1]``, through folds, until alpha leaves the
         window. Where W is carried in extended precision, a stage of that solve that
         stalls has its last iterate solved again on its piece in double-double until the
-        classes settle. Where that solve fails at ``alpha_start``, the start is the point at
+        classes settle. Where that solve fails at ``alpha_start`` (every stage but its long
+        Gauss-Seidel run and restarts, which come after the rays), the start is the point at
         tau = 1 of the path of the load tau f(alpha_start) from zero load (tau = 0), or
         where that path cannot leave tau = 0 (every gap zero), from a load that holds every
         node open; where neither gets there, it solves at a nearby alpha (1e-3, 1e-2, 1e-1

@@ -811,18 +811,20 @@ pub unsafe extern "C" fn fricont_path_set_monitor(
 /// `guess` is NULL, from zero forces. A restart clears the events and pieces traced so
 /// far. The load callbacks may be called. Where W is carried beyond double precision, a
 /// stage that stalls has its last iterate solved again on its piece in double-double until
-/// the classes settle (an exact solution to that precision). Where every stage of the
-/// solver fails at `alpha`, it traces the path of the load `τ f(alpha)` from zero load
-/// (τ = 0, zero forces where every gap is ≥ 0) to τ = 1, through its folds, and its point
-/// at τ = 1 is the start; where that path cannot leave τ = 0 (every gap zero: every node
-/// at the vertex of its cone), the same ray from a load that holds every node open. Where
-/// neither gets there, it solves at a nearby α (1e-3, 1e-2, then 1e-1 of the window's
-/// length away, or of a thousand times the load's own α scale at `alpha` where that is
-/// shorter, the larger of `‖q‖∞ / ‖q'‖∞` and `|alpha − alpha_start|`; toward `alpha_end`
-/// first, inside the window) and traces the path from there back to `alpha`: the point it
-/// reaches is the start (`FRICONT_ERR_SOLVE_FAILED` only where none leads there; the
-/// message says what each attempt reached). A failed solve costs about as much at a
-/// nearby α as at `alpha` (a minute at p = 1500 with F = 5), hence the rays first.
+/// the classes settle (an exact solution to that precision). Where the solver fails at
+/// `alpha` (every stage but its long runs: 20,000 Gauss–Seidel sweeps and restarts of
+/// Newton), it traces the path of the load `τ f(alpha)` from zero load (τ = 0, zero
+/// forces where every gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1 is
+/// the start; where that path cannot leave τ = 0 (every gap zero: every node at the
+/// vertex of its cone), the same ray from a load that holds every node open. Where
+/// neither gets there, the solver's long runs follow, then it solves at a nearby α (1e-3,
+/// 1e-2, then 1e-1 of the window's length away, or of a thousand times the load's own α
+/// scale at `alpha` where that is shorter, the larger of `‖q‖∞ / ‖q'‖∞` and
+/// `|alpha − alpha_start|`; toward `alpha_end` first, inside the window) and traces the
+/// path from there back to `alpha`: the point it reaches is the start
+/// (`FRICONT_ERR_SOLVE_FAILED` only where none leads there; the message says what each
+/// attempt reached). A failed solve costs about as much at a nearby α as at `alpha` (a
+/// minute at p = 1500 with F = 5, half of it in the long runs), hence the rays first.
 /// `fricont_path_start_route` says which of these reached the start.
 ///
 /// The problem at one α can have several solutions (large friction, a path that folds

@@ -1763,26 +1763,42 @@ impl Path {
     /// stage of the fixed-α solver that stalls has its last iterate solved again on its
     /// piece in double-double until the classes settle (an exact solution of `H = 0` to
     /// that precision, reached where no double iterate reaches 1e-12 on an ill-conditioned W).
-    /// Where the fixed-α solver fails at `alpha`, the start is reached from zero load: the
-    /// path of the same problem under the load `τ f(alpha)` is traced from τ = 0 (zero
+    /// Where the fixed-α solver fails at `alpha` (every stage but its long runs, the
+    /// 20,000 Gauss–Seidel sweeps and the restarts), the start is reached from zero load:
+    /// the path of the same problem under the load `τ f(alpha)` is traced from τ = 0 (zero
     /// forces, where every gap is ≥ 0) to τ = 1, through its folds, and its point at τ = 1
     /// is the start; where that path does not get there (it cannot leave τ = 0 where every
     /// gap is zero), the same ray from a load that holds every node open at τ = 0 (on the
     /// equilibrated W in double; its point at τ = 1 is the start's guess).
-    /// Where that fails too, it solves at a nearby α instead (1e-3, 1e-2, 1e-1 of the
-    /// window's length away, or of 1e3 times the load's own α scale at `alpha`,
-    /// `max(‖q‖∞ / ‖q'‖∞, |alpha − alpha_start|)`, where that is shorter, toward
-    /// `alpha_end` first) and traces the path from there back to `alpha`: its point there
-    /// is the start. [`Path::start_route`] says which of these reached the start.
+    /// Where that fails too, every stage of the solver runs at `alpha`, and where that
+    /// fails, it solves at a nearby α instead (1e-3, 1e-2, 1e-1 of the window's length
+    /// away, or of 1e3 times the load's own α scale at `alpha`, `max(‖q‖∞ / ‖q'‖∞,
+    /// |alpha − alpha_start|)`, where that is shorter, toward `alpha_end` first) and
+    /// traces the path from there back to `alpha`: its point there is the start.
+    /// [`Path::start_route`] says which of these reached the start.
     /// Errors: `alpha` outside the window, guess of wrong length or non-finite, the solve
     /// fails (also from every nearby α and from zero load), the load fails, no piece
     /// leaves the start point toward `alpha_end`.
     pub fn start(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
-        // The rays before the nearby α: each nearby α is a solve of its own, which fails
-        // as slowly as the one at `alpha` where it fails too (see `start_from_zero_load`).
-        let r = match self.start_solved(alpha, guess) {
+        // The rays before the solver's long runs and the nearby α: where those fail, they
+        // cost far more than the rays (each nearby α is a solve of its own; see
+        // `start_from_zero_load`). Where the rays fail, every stage of the solver runs
+        // (the first ones again), then the nearby α.
+        let r = match self.start_solved(alpha, guess, Stages::NoLongRuns) {
             Err(Error::SolveFailed { message, .. }) => self.start_from_zero_load(alpha, message),
             r => r.map(|()| StartRoute::Solved),
+        };
+        let r = match r {
+            Err(Error::SolveFailed { message, .. }) => {
+                match self.start_solved(alpha, guess, Stages::All) {
+                    Err(Error::SolveFailed { message: all, .. }) => Err(Error::SolveFailed {
+                        alpha,
+                        message: format!("{message}; every stage of the solver: {all}"),
+                    }),
+                    r => r.map(|()| StartRoute::Solved),
+                }
+            }
+            r => r,
         };
         let route = match r {
             Err(Error::SolveFailed { message, .. }) => self
@@ -1804,7 +1820,9 @@ impl Path {
     /// much as the one that failed where it fails too: on a strip with p = 1500 and
     /// F = 5 (`fe_strip` seed 3 of the tests, 1500 × 2 elements) every stage failed at
     /// α = −2 in 64 s and at three nearby α in 54–64 s each, while this ray reached the
-    /// start in 1.3 s (59 transitions). So the rays come first, the nearby α after them.
+    /// start in 1.3 s (59 transitions); of the 64 s at α = −2, the solver's long runs
+    /// (20,000 Gauss–Seidel sweeps and the restarts) took 29 s. So the rays come before
+    /// those long runs, and the nearby α after them.
     /// At τ = 0 the load is zero, and where every gap is ≥ 0 the forces are zero: a start
     /// the solver finds at once, and the only solution there (with no load, forces that
     /// satisfy the contact and friction conditions do no positive work, `λᵀ W λ ≤ 0`, and
@@ -1836,7 +1854,9 @@ impl Path {
             },
         };
         match end {
-            Ok((lam, route)) => self.start_solved(alpha, Some(&lam)).map(|()| route),
+            Ok((lam, route)) => self
+                .start_solved(alpha, Some(&lam), Stages::All)
+                .map(|()| route),
             Err(why) => Err(Error::SolveFailed {
                 alpha,
                 message: format!(
@@ -1901,16 +1921,21 @@ impl Path {
             ..self.opts.clone()
         };
         let mut sub = Path::new(problem, ray, opts)?;
-        Ok(match sub.start_solved(0.0, None).and_then(|_| sub.run()) {
-            Ok(EndReason::Window) => match sub.pieces().last() {
-                Some(pc) if pc.alpha_to == 1.0 => Ok(pc.lambda_to.clone()),
-                Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
-                None => Err("it traced no piece".to_string()),
+        Ok(
+            match sub
+                .start_solved(0.0, None, Stages::All)
+                .and_then(|_| sub.run())
+            {
+                Ok(EndReason::Window) => match sub.pieces().last() {
+                    Some(pc) if pc.alpha_to == 1.0 => Ok(pc.lambda_to.clone()),
+                    Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
+                    None => Err("it traced no piece".to_string()),
+                },
+                Ok(r) => Err(format!("it ended ({})", r.name())),
+                Err(e @ Error::Load { .. }) => return Err(e),
+                Err(e) => Err(e.to_string()),
             },
-            Ok(r) => Err(format!("it ended ({})", r.name())),
-            Err(e @ Error::Load { .. }) => return Err(e),
-            Err(e) => Err(e.to_string()),
-        })
+        )
     }
 
     /// The last fallback of [`Self::start`], where the fixed-α solver and the rays of
@@ -1945,7 +1970,9 @@ impl Path {
                 }
                 self.opts.alpha_start = a1;
                 self.opts.alpha_end = alpha;
-                let run = self.start_solved(a1, None).and_then(|_| self.run());
+                let run = self
+                    .start_solved(a1, None, Stages::All)
+                    .and_then(|_| self.run());
                 let end = self
                     .pieces()
                     .last()
@@ -1973,7 +2000,7 @@ impl Path {
         self.scale_cache.clear();
         self.trace = None;
         match reached {
-            Some(lam) => self.start_solved(alpha, Some(&lam?)),
+            Some(lam) => self.start_solved(alpha, Some(&lam?), Stages::All),
             None => Err(Error::SolveFailed {
                 alpha,
                 message: format!(
@@ -1985,7 +2012,7 @@ impl Path {
     }
 
     /// [`Self::start`] with the fixed-α solver at `alpha` only.
-    fn start_solved(&mut self, alpha: f64, guess: Option<&[f64]>) -> Result<()> {
+    fn start_solved(&mut self, alpha: f64, guess: Option<&[f64]>, stages: Stages) -> Result<()> {
         let _pool = self.pool_scope();
         self.trace = None;
         // A path's numbers depend on its own history only: no factorisation from an
@@ -2028,13 +2055,24 @@ impl Path {
                 .map(|(lam, _)| lam)
         };
         #[cfg(test)]
-        if guess.is_none() && tests::REFUSE_START_AT.get() == Some(alpha) {
+        if guess.is_none()
+            && tests::REFUSE_START_AT
+                .get()
+                .is_some_and(|(a, long)| a == alpha && (long || stages != Stages::All))
+        {
             return Err(Error::SolveFailed {
                 alpha,
                 message: "refused by the test switch".to_string(),
             });
         }
-        let lam = solve_fixed_alpha(&problem, &qg, guess.as_deref(), alpha, Some(&mut polish))?;
+        let lam = solve_fixed_alpha(
+            &problem,
+            &qg,
+            guess.as_deref(),
+            alpha,
+            stages,
+            Some(&mut polish),
+        )?;
         let mut pt = Point { lam, ..pt };
         let mut tol = self.tol_at(&pt);
         let p = self.problem.p();
@@ -2512,8 +2550,9 @@ mod tests {
 
     thread_local! {
         /// Test switch: the fixed-α solver fails at this α when started without a guess,
-        /// as where every stage stalls at the start's α but not near it.
-        pub(super) static REFUSE_START_AT: std::cell::Cell<Option<f64>> =
+        /// as where every stage stalls at the start's α but not near it; with `false`, the
+        /// long runs of `Stages::All` succeed (as where only they reach a solution).
+        pub(super) static REFUSE_START_AT: std::cell::Cell<Option<(f64, bool)>> =
             const { std::cell::Cell::new(None) };
         /// Test switch: the rays of `start_from_zero_load` fail at once.
         pub(super) static REFUSE_RAYS: std::cell::Cell<bool> =
@@ -2577,8 +2616,10 @@ mod tests {
     /// F = 1/2, gap 0, f(α) = (1, 0) + α (0, 1). At α ∈ [0, 1/2] the node sticks with
     /// λ = (−1, −α); it slips in +t from α = 1/2 (λt reaches F λν = −1/2). Started at
     /// α = 1/4: where the solver fails there, the start comes from the ray `τ f(1/4)` from
-    /// zero load (along which the node sticks, λ = −τ (1, 1/4), from τ = 0 on); where the
-    /// rays fail too, from a nearby α. Each says so; the same start and event.
+    /// zero load (along which the node sticks, λ = −τ (1, 1/4), from τ = 0 on), also where
+    /// the solver's long runs would solve it (they come after the rays); where the rays
+    /// fail, from those long runs, and where they fail too, from a nearby α. Each says so;
+    /// the same start and event.
     #[test]
     fn a_start_the_solver_misses_comes_from_a_ray_or_a_nearby_alpha_and_says_so() {
         let csr = |r, c, v: &[f64]| CsrMatrix::from_dense(r, c, v).unwrap();
@@ -2595,8 +2636,9 @@ mod tests {
         );
         for (refuse, rays, route) in [
             (None, true, StartRoute::Solved),
-            (Some(0.25), false, StartRoute::ZeroLoad),
-            (Some(0.25), true, StartRoute::Nearby),
+            (Some((0.25, false)), false, StartRoute::ZeroLoad),
+            (Some((0.25, false)), true, StartRoute::Solved),
+            (Some((0.25, true)), true, StartRoute::Nearby),
         ] {
             let load = Load::affine(vec![1.0, 0.0], vec![0.0, 1.0]).unwrap();
             let mut path =
