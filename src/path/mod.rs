@@ -2559,6 +2559,24 @@ mod tests {
             const { std::cell::Cell::new(false) };
     }
 
+    /// The block on a foundation of the tests below: A = diag(2, 1), N = [1, 0],
+    /// T = [0, 1], F = 1/2, with the gap `gap`.
+    fn block(gap: f64) -> Arc<Problem> {
+        let csr = |r, c, v: &[f64]| CsrMatrix::from_dense(r, c, v).unwrap();
+        Arc::new(
+            ProblemBuilder::new(
+                csr(2, 2, &[2.0, 0.0, 0.0, 1.0]),
+                Storage::Full,
+                csr(1, 2, &[1.0, 0.0]),
+                csr(1, 2, &[0.0, 1.0]),
+            )
+            .friction_uniform(0.5)
+            .gap(vec![gap])
+            .build()
+            .unwrap(),
+        )
+    }
+
     /// The block of the next test with a gap of 0.1 under the load ray f(α) = α (1, 1/4),
     /// as `start_from_zero_load` traces it: at α = 0 the load and the forces are zero and
     /// the node is open; its piece's tangent is λ' = 0 (t = (0, 0, t_α), t_α > 0). The
@@ -2570,19 +2588,7 @@ mod tests {
     /// (λ = (0.2 − α, −α/4), within the cone).
     #[test]
     fn the_tangent_at_zero_load_comes_from_the_updated_factorisation() {
-        let csr = |r, c, v: &[f64]| CsrMatrix::from_dense(r, c, v).unwrap();
-        let problem = Arc::new(
-            ProblemBuilder::new(
-                csr(2, 2, &[2.0, 0.0, 0.0, 1.0]),
-                Storage::Full,
-                csr(1, 2, &[1.0, 0.0]),
-                csr(1, 2, &[0.0, 1.0]),
-            )
-            .friction_uniform(0.5)
-            .gap(vec![0.1])
-            .build()
-            .unwrap(),
-        );
+        let problem = block(0.1);
         let load = Load::affine(vec![0.0, 0.0], vec![1.0, 0.25]).unwrap();
         let mut path = Path::new(problem, load, PathOptions::window(0.0, 1.0)).unwrap();
         path.start(0.0, None).unwrap();
@@ -2622,18 +2628,7 @@ mod tests {
     /// the same start and event.
     #[test]
     fn a_start_the_solver_misses_comes_from_a_ray_or_a_nearby_alpha_and_says_so() {
-        let csr = |r, c, v: &[f64]| CsrMatrix::from_dense(r, c, v).unwrap();
-        let problem = Arc::new(
-            ProblemBuilder::new(
-                csr(2, 2, &[2.0, 0.0, 0.0, 1.0]),
-                Storage::Full,
-                csr(1, 2, &[1.0, 0.0]),
-                csr(1, 2, &[0.0, 1.0]),
-            )
-            .friction_uniform(0.5)
-            .build()
-            .unwrap(),
-        );
+        let problem = block(0.0);
         for (refuse, rays, route) in [
             (None, true, StartRoute::Solved),
             (Some((0.25, false)), false, StartRoute::ZeroLoad),
