@@ -1921,21 +1921,19 @@ impl Path {
             ..self.opts.clone()
         };
         let mut sub = Path::new(problem, ray, opts)?;
-        Ok(
-            match sub
-                .start_solved(0.0, None, Stages::All)
-                .and_then(|_| sub.run())
-            {
-                Ok(EndReason::Window) => match sub.pieces().last() {
-                    Some(pc) if pc.alpha_to == 1.0 => Ok(pc.lambda_to.clone()),
-                    Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
-                    None => Err("it traced no piece".to_string()),
-                },
-                Ok(r) => Err(format!("it ended ({})", r.name())),
-                Err(e @ Error::Load { .. }) => return Err(e),
-                Err(e) => Err(e.to_string()),
+        let run = sub
+            .start_solved(0.0, None, Stages::All)
+            .and_then(|_| sub.run());
+        Ok(match run {
+            Ok(EndReason::Window) => match sub.pieces().last() {
+                Some(pc) if pc.alpha_to == 1.0 => Ok(pc.lambda_to.clone()),
+                Some(pc) => Err(format!("it came back to tau = {:e}", pc.alpha_to)),
+                None => Err("it traced no piece".to_string()),
             },
-        )
+            Ok(r) => Err(format!("it ended ({})", r.name())),
+            Err(e @ Error::Load { .. }) => return Err(e),
+            Err(e) => Err(e.to_string()),
+        })
     }
 
     /// The last fallback of [`Self::start`], where the fixed-α solver and the rays of
