@@ -1260,22 +1260,35 @@ impl Path {
                             && dir * rows[k].slope > 0.0
                     })
                     .map(|(a, rows)| (*a, rows[k].slope));
+                // A guard the piece was entered through (`below`), rising at α_a and
+                // falling at α_b: it turned down on this step, and its root is the one
+                // after its maximum. Taken from α_a (at or below zero there, the root was α_a,
+                // then moved onto the guard's zero along the piece), it was the rising zero,
+                // the piece's entry: under a load turning just past a touchdown (φ's maximum
+                // 1e-8 beyond it, relative) the touchdown came out 4e-8 in α early (its gap
+                // flat within rounding), the contact force at the entry was −1.2e-11
+                // (threshold 1.4e-12), and the node lifted off where it had touched down:
+                // the way back was taken as a fold, and the path went back to the window's
+                // start without an error.
+                let entered =
+                    below[k] && dir * ga[k].slope > 0.0 && dir * gb[k].slope < 0.0 && fa <= tol[k];
+                let top_on = |this: &mut Self, (a, sa): (f64, f64), (b, sb): (f64, f64)| {
+                    let top = brent_fallible(a, b, dir * sa, dir * sb, |x| {
+                        Ok(dir * eval(this, x, false)?.1[k].slope)
+                    })?;
+                    let row = eval(this, top, false)?.1[k].clone();
+                    Ok::<_, Error>((row.value > 0.0).then_some((top, row.value, row.slope)))
+                };
                 let peak = match turned {
-                    Some((a_prev, s_prev)) => {
-                        let top =
-                            brent_fallible(a_prev, a0, dir * s_prev, dir * ga[k].slope, |x| {
-                                Ok(dir * eval(self, x, false)?.1[k].slope)
-                            })?;
-                        let row = eval(self, top, false)?.1[k].clone();
-                        (row.value > 0.0).then_some((top, row.value, row.slope))
-                    }
+                    Some((a_prev, s_prev)) => top_on(self, (a_prev, s_prev), (a0, ga[k].slope))?,
+                    None if entered => top_on(self, (a0, ga[k].slope), (b0, gb[k].slope))?,
                     None => None,
                 };
                 // The root's bracket: after the maximum, on the step before, or on this
                 // step (none for a guard already at or below zero at α_a: the root is α_a).
                 let sa = (a0, fa, ga[k].slope);
                 let bracket = if let Some(top) = peak {
-                    Some((top, sa))
+                    Some((top, if entered { (b0, fb, gb[k].slope) } else { sa }))
                 } else if let Some((a_prev, _, value, slope)) = earlier {
                     Some(((a_prev, value, slope), sa))
                 } else if fa <= 0.0 {
@@ -1289,8 +1302,13 @@ impl Path {
                 // lift-off, the gap's maximum was 8e-14 against 9e-14, and the node touched
                 // down at φ's turn, where no direction along α is decided). There the value
                 // must also be below a sixteenth of the maximum's.
+                // Likewise before a minimum, where the step ends at one (`cut`): there the
+                // value must be below a sixteenth of the minimum's depth. At a turn of φ 1e-8
+                // past a touchdown, the gap's minimum was −6.7e-15 against 2.1e-14, and the
+                // node touched down at φ's turn, 4e-5 in α late.
                 let accept = match peak {
                     Some((_, top, _)) => (fine * tol[k]).min(top / 16.0),
+                    None if cut.is_some() && fb < 0.0 => (fine * tol[k]).min(-fb / 16.0),
                     None => fine * tol[k],
                 };
                 let root = match bracket {
