@@ -909,7 +909,8 @@ fn a_general_load_does_not_merge_a_grazing_touchdown_into_another_transition() {
 #[test]
 fn a_load_turning_just_past_a_transition_comes_back_through_it() {
     // (strip, node switching at s_k (1-based), its class after, s_k roughly where the node
-    // switches more than once, d, the load as a general load too)
+    // switches more than once, d, the load as a general load too, whether the path may
+    // stop with the error naming a way back instead)
     let strip98 = (98u64, 138usize, 1usize, 0.4951900771206396, 0.178);
     let cases = [
         (
@@ -919,6 +920,7 @@ fn a_load_turning_just_past_a_transition_comes_back_through_it() {
             None,
             1e-5,
             true,
+            false,
         ),
         (
             (2, 57, 3, 0.46368478231107124, 0.277),
@@ -927,16 +929,38 @@ fn a_load_turning_just_past_a_transition_comes_back_through_it() {
             None,
             1e-6,
             true,
+            false,
         ),
-        (strip98, 129, Class::Open, None, 1e-8, false),
+        (strip98, 129, Class::Open, None, 1e-8, false, false),
         // touchdowns whose contact force, entered 4e-8 in α early (the gap flat within its
         // rounding), was taken to leave at the touchdown's own α; and whose gap, 6.7e-15
         // below zero at φ's turn, had its root taken there
-        (strip98, 117, Class::SlipMinus, Some(-0.237), 1e-8, true),
-        (strip98, 87, Class::SlipMinus, Some(-0.179), 1e-8, true),
+        (
+            strip98,
+            117,
+            Class::SlipMinus,
+            Some(-0.237),
+            1e-8,
+            true,
+            false,
+        ),
+        (
+            strip98,
+            87,
+            Class::SlipMinus,
+            Some(-0.179),
+            1e-8,
+            true,
+            false,
+        ),
+        // a lift-off whose gap, 1e-10 past it, rises to 4e-17 about φ's turn, below its
+        // rounding: the lift-off and the touchdown 8e-6 in α later are not resolved, and
+        // the path took the gap's root 1.9e-13 after the lift-off, walked back along the
+        // slipping piece and went back to the window's start without an error
+        (strip98, 99, Class::Open, Some(0.504), 1e-10, false, true),
     ];
     let (amp, omega, wspan) = (0.5, 5.0, 0.05);
-    for ((seed, nx, ny, f, ly), node, after, near, d, general) in cases {
+    for ((seed, nx, ny, f, ly), node, after, near, d, general, may_stop) in cases {
         // The affine reference over a stretch of φ holding the transition (found first on a
         // wider one, then each trace's expected events from it).
         let mut case = common::fe_strip(seed, nx, ny, f, 10.0, ly);
@@ -1004,7 +1028,17 @@ fn a_load_turning_just_past_a_transition_comes_back_through_it() {
             let mut path =
                 Path::new(problem.clone(), load, PathOptions::window(start, end)).unwrap();
             path.start(start, None).unwrap();
-            assert_eq!(path.run().unwrap(), EndReason::Window, "{ctx}");
+            match path.run() {
+                Err(e) if may_stop => {
+                    let msg = e.to_string();
+                    assert!(
+                        msg.contains("walks back along the path's own pieces"),
+                        "{ctx}: {msg}"
+                    );
+                    continue;
+                }
+                end => assert_eq!(end.unwrap(), EndReason::Window, "{ctx}"),
+            }
             assert!(path.events().iter().all(|e| !e.fold), "{ctx}: a fold");
             let mut got: Vec<(f64, f64, usize, Class, Class)> = path
                 .events()
