@@ -958,6 +958,10 @@ fn a_load_turning_just_past_a_transition_comes_back_through_it() {
         // the path took the gap's root 1.9e-13 after the lift-off, walked back along the
         // slipping piece and went back to the window's start without an error
         (strip98, 99, Class::Open, Some(0.504), 1e-10, false, true),
+        // a lift-off whose gap's root was taken 2.6e-6 in α after it (before φ's turn,
+        // the forces moving by 1e-10 of their scale along that piece): the walk back
+        // along the slipping piece was taken as a fold
+        (strip98, 105, Class::Open, Some(0.173), 1e-10, false, true),
     ];
     let (amp, omega, wspan) = (0.5, 5.0, 0.05);
     for ((seed, nx, ny, f, ly), node, after, near, d, general, may_stop) in cases {

@@ -788,7 +788,8 @@ impl Path {
         // walked the other way.
         // The path's last pieces before the current one, the latest first; the walk back
         // along the first `recent` of them is the way the path came. `looped`: under a
-        // nonlinear load, the current piece a rounding long in α and in the forces too.
+        // nonlinear load, the current piece a rounding long in the forces (whatever its
+        // length in α).
         let (last, recent, looped): (Vec<(Vec<Class>, i8)>, usize, bool) = {
             // (the forces' change against the point's force scale, as `rounding_short`
             // measures it: their rounding is relative to the load's terms, not to the
@@ -818,12 +819,21 @@ impl Path {
             // a fifth of their threshold. Both times stick fitted the point again, the way
             // back along the sticking piece was taken for a second continuation, and the
             // lift-off was flagged as a bifurcation that double-double does not have.
+            // A current piece whose forces moved by a rounding only counts as a rounding
+            // long too: under a nonlinear load that turns there, its α may be noise (a
+            // basis load turning 1e-10, relative in φ, past a lift-off: the node's gap
+            // was taken to close again 2.6e-6 in α later, the forces moving by 1e-10 of
+            // their scale, and the walk back along the slipping piece was taken as a fold).
             let tr = self.trace.as_ref().expect("started");
             let n = tr.pieces.len().saturating_sub(1);
             let pieces = &tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n];
             let mut recent = 0;
+            let still = |l0: &[f64], l1: &[f64]| {
+                max_abs_diff(l0, l1) <= ROUNDING_LONG * scale.max(inf_norm(l0)).max(inf_norm(l1))
+            };
             let mut across = self.load.is_affine()
-                || (pt.alpha - cur.alpha).abs() <= ROUNDING_LONG * cur.alpha.abs().max(1.0);
+                || (pt.alpha - cur.alpha).abs() <= ROUNDING_LONG * cur.alpha.abs().max(1.0)
+                || still(&cur.lam, &pt.lam);
             for p in pieces.iter().rev() {
                 if !across {
                     break;
@@ -841,7 +851,7 @@ impl Path {
                 .rev()
                 .map(|p| (p.classes.clone(), p.direction))
                 .collect();
-            let looped = !self.load.is_affine() && tiny(cur.alpha, pt.alpha, &cur.lam, &pt.lam);
+            let looped = !self.load.is_affine() && still(&cur.lam, &pt.lam);
             (last, recent, looped)
         };
         // (whether `cd` walks back along one of `pieces`)
@@ -1098,9 +1108,10 @@ impl Path {
         // 2001 × 3 strip on 200 × 0.2 (F = 1, double-double) near α = −2 the path holds
         // from the data along it (`python/tests/test_from_data.py`).
         // Not under a nonlinear load where every way back retraces the path across pieces
-        // a rounding long, the current one included: the path would go back over what it
-        // has traced, along the piece it left a rounding ago, which a path of solutions
-        // does not do (no test or sweep takes that way back). Under a basis load turning 1e-10
+        // a rounding long, the current one included (in the forces, see `looped`): the
+        // path would go back over what it has traced, along the piece it left a rounding
+        // ago, which a path of solutions does not do (no test or sweep takes that way
+        // back). Under a basis load turning 1e-10
         // (relative, in φ) past a lift-off, the node's gap, rising to 4e-17 about the turn
         // (its rounding 5e-16), was taken to close again 1.9e-13 in α after it opened:
         // the way back along the slipping piece was the only continuation, and the path
@@ -1120,7 +1131,7 @@ impl Path {
         if cands.is_empty() {
             if loops_back {
                 return Err(Error::Numerical(format!(
-                    "at alpha = {:e} the only continuation walks back along the path's own pieces: node(s) {:?} switched there and back within a rounding of alpha and of the forces, and the path would retrace itself; under this nonlinear load a guard of theirs stays within its rounding of zero about here (a load that turns, or is nearly stationary, within the data's resolution of a transition)",
+                    "at alpha = {:e} the only continuation walks back along the path's own pieces: node(s) {:?} switched there and back within a rounding of the forces, and the path would retrace itself; under this nonlinear load a guard of theirs stays within its rounding of zero about here (a load that turns, or is nearly stationary, within the data's resolution of a transition)",
                     pt.alpha,
                     nodes.iter().map(|i| i + 1).collect::<Vec<_>>()
                 )));
