@@ -799,10 +799,11 @@ impl Path {
             // force scale, took the walk back for a second continuation: the first event
             // was flagged as a bifurcation that double-double does not have.)
             let scale = self.force_scale(&pt);
+            let still = |l0: &[f64], l1: &[f64]| {
+                max_abs_diff(l0, l1) <= ROUNDING_LONG * scale.max(inf_norm(l0)).max(inf_norm(l1))
+            };
             let tiny = |a0: f64, a1: f64, l0: &[f64], l1: &[f64]| {
-                let scale = scale.max(inf_norm(l0)).max(inf_norm(l1));
-                (a1 - a0).abs() <= ROUNDING_LONG * a0.abs().max(1.0)
-                    && max_abs_diff(l0, l1) <= ROUNDING_LONG * scale
+                (a1 - a0).abs() <= ROUNDING_LONG * a0.abs().max(1.0) && still(l0, l1)
             };
             // The piece before the current one is walked back across the current one
             // under an affine load always, else wherever the current piece is a rounding
@@ -828,9 +829,6 @@ impl Path {
             let n = tr.pieces.len().saturating_sub(1);
             let pieces = &tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n];
             let mut recent = 0;
-            let still = |l0: &[f64], l1: &[f64]| {
-                max_abs_diff(l0, l1) <= ROUNDING_LONG * scale.max(inf_norm(l0)).max(inf_norm(l1))
-            };
             let mut across = self.load.is_affine()
                 || (pt.alpha - cur.alpha).abs() <= ROUNDING_LONG * cur.alpha.abs().max(1.0)
                 || still(&cur.lam, &pt.lam);
