@@ -1109,11 +1109,11 @@ impl Path {
         // a rounding long, the current one included (in the forces, see `looped`): the
         // path would go back over what it has traced, along the piece it left a rounding
         // ago, which a path of solutions does not do (no test or sweep takes that way
-        // back). Under a basis load turning 1e-10
-        // (relative, in φ) past a lift-off, the node's gap, rising to 4e-17 about the turn
-        // (its rounding 5e-16), was taken to close again 1.9e-13 in α after it opened:
-        // the way back along the slipping piece was the only continuation, and the path
-        // went back to the window's start without an error.
+        // back). Under a basis load turning 1e-10 (relative, in φ) past a lift-off, the
+        // node's gap, rising to 4e-17 about the turn (its rounding 5e-16), was taken to
+        // close again 1.9e-13 in α after it opened: the way back along the slipping
+        // piece was the only continuation, and the path went back to the window's start
+        // without an error.
         let loops_back = cands.is_empty()
             && looped
             && !walked_back.is_empty()
