@@ -829,9 +829,10 @@ impl Path {
             let n = tr.pieces.len().saturating_sub(1);
             let pieces = &tr.pieces[n.saturating_sub(RETRACE_LOOKBACK)..n];
             let mut recent = 0;
+            let cur_still = still(&cur.lam, &pt.lam);
             let mut across = self.load.is_affine()
                 || (pt.alpha - cur.alpha).abs() <= ROUNDING_LONG * cur.alpha.abs().max(1.0)
-                || still(&cur.lam, &pt.lam);
+                || cur_still;
             for p in pieces.iter().rev() {
                 if !across {
                     break;
@@ -849,7 +850,7 @@ impl Path {
                 .rev()
                 .map(|p| (p.classes.clone(), p.direction))
                 .collect();
-            let looped = !self.load.is_affine() && still(&cur.lam, &pt.lam);
+            let looped = !self.load.is_affine() && cur_still;
             (last, recent, looped)
         };
         // (whether `cd` walks back along one of `pieces`)
