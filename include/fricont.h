@@ -232,11 +232,14 @@ enum fricont_class
      */
     FRICONT_OPEN = 0,
     /**
-     * Contact, stick: dν = dt = 0, guards λν < 0, F λν < λt < −F λν.
+     * Contact, stick: dν = dt = 0, guards λν < 0, F λν < λt < −F λν (never at a
+     * frictionless node, F = 0: its region is empty there).
      */
     FRICONT_STICK = 1,
     /**
-     * Contact, slip in +t: dν = 0, λt = F λν, guards λν < 0, dt > 0.
+     * Contact, slip in +t: dν = 0, λt = F λν, guards λν < 0, dt > 0. A frictionless
+     * node in contact is in slip+ or slip- by the sign of its dt; where dt stays at zero
+     * it keeps the sign it had (slip+ where it touched down so).
      */
     FRICONT_SLIP_PLUS = 2,
     /**

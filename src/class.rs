@@ -6,9 +6,12 @@
 pub enum Class {
     /// No contact: `λν = λt = 0`, guard `dν < 0`.
     Open = 0,
-    /// Contact, stick: `dν = dt = 0`, guards `λν < 0`, `F λν < λt < −F λν`.
+    /// Contact, stick: `dν = dt = 0`, guards `λν < 0`, `F λν < λt < −F λν` (never at a
+    /// frictionless node, F = 0: its region is empty there).
     Stick = 1,
-    /// Contact, slip in +t: `dν = 0`, `λt = F λν`, guards `λν < 0`, `dt > 0`.
+    /// Contact, slip in +t: `dν = 0`, `λt = F λν`, guards `λν < 0`, `dt > 0`. A
+    /// frictionless node in contact is in S+ or S− by the sign of its dt; where dt stays
+    /// at zero it keeps the sign it had (S+ where it touched down so).
     SlipPlus = 2,
     /// Contact, slip in −t: `dν = 0`, `λt = −F λν`, guards `λν < 0`, `dt < 0`.
     SlipMinus = 3,

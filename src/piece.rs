@@ -142,6 +142,13 @@ impl<'a> PieceConstants<'a> {
         }
     }
 
+    /// Whether `g` is the slip guard (dt's sign) of a frictionless node (F = 0): its S+ and
+    /// S− have the same equations (dν = 0, λt = 0), so the guard's side names the class
+    /// and constrains nothing.
+    pub fn label_only(&self, g: Guard) -> bool {
+        matches!(g.kind, GuardKind::SlipPos | GuardKind::SlipNeg) && self.friction[g.node] == 0.0
+    }
+
     /// The guard as a linear form in force units.
     pub fn guard_form(&self, g: Guard) -> LinForm {
         let (i, p, f, r0) = (g.node, self.p, self.friction[g.node], self.r0);

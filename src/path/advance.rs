@@ -43,9 +43,21 @@ struct Thresholds {
 }
 
 impl Thresholds {
-    fn new(tol: Tol, forms: Vec<crate::piece::LinForm>) -> Self {
+    /// `labels[k]`: row k is a frictionless node's slip guard, its threshold
+    /// [`Tol::label_of`].
+    fn new(tol: Tol, forms: Vec<crate::piece::LinForm>, labels: &[bool]) -> Self {
         let upper = forms.iter().map(|f| tol.upper(f) * (1.0 + 1e-10)).collect();
-        let exact = forms.iter().map(|_| std::cell::OnceCell::new()).collect();
+        let exact = forms
+            .iter()
+            .zip(labels)
+            .map(|(f, &label)| {
+                let cell = std::cell::OnceCell::new();
+                if label {
+                    let _ = cell.set(tol.label_of(f));
+                }
+                cell
+            })
+            .collect();
         Self {
             tol,
             forms,
@@ -527,7 +539,18 @@ impl Path {
             // zero whose slope is within the slope threshold counts as not decreasing (it
             // was let in on that slope); one inside the piece that decreases however
             // slowly does cross, and where it crosses first it is the exit.
-            if vd < -tol.slope() || (vd < 0.0 && !tol.at_zero(&c.guard_form(g), v, vd)) {
+            //
+            // A frictionless node's dt (its slip guard) decreases only beyond the slope
+            // threshold: where it stays at zero (the node on a symmetric body's axis, alone
+            // in contact), its value is the rounding of W's entries that vanish by symmetry
+            // (2e-17 against a threshold of a hundredth of that, the row's terms being
+            // that rounding too), and its root along a slope of that size was the exit:
+            // 1.0 in α behind the entry. Its side only names its class (S+ or S−, the same
+            // equations), so it need not be resolved below the slope threshold.
+            let label_only = c.label_only(g);
+            if vd < -tol.slope()
+                || (!label_only && vd < 0.0 && !tol.at_zero(&c.guard_form(g), v, vd))
+            {
                 let s = (v / -vd).max(0.0);
                 decreasing.push(g);
                 if best.is_none_or(|b| s < b.0) {
@@ -937,7 +960,8 @@ impl Path {
             let tol = {
                 let c = self.consts();
                 let forms = ga.iter().map(|row| c.guard_form(row.guard)).collect();
-                Thresholds::new(self.tol_at(&pa), forms)
+                let labels: Vec<bool> = ga.iter().map(|row| c.label_only(row.guard)).collect();
+                Thresholds::new(self.tol_at(&pa), forms, &labels)
             };
             let below = below.get_or_insert_with(|| {
                 (0..ga.len())
@@ -1143,10 +1167,13 @@ impl Path {
                             rows[k].guard == gb[k].guard && rows[k].value > 0.0 && falling(&rows[k])
                         }))
             };
+            // (A frictionless node's slip guard crosses only below its threshold: its value
+            // where it stays at zero is rounding of either sign, see `Tol::label_of`.)
+            let c = self.consts();
             let crossing: Vec<usize> = (0..gb.len())
                 .filter(|&k| {
                     (tol.below(k, gb[k].value, 1.0) && !(below[k] && dir * gb[k].slope > 0.0))
-                        || through(k)
+                        || (through(k) && !c.label_only(gb[k].guard))
                 })
                 .collect();
             if crossing.is_empty() {

@@ -212,8 +212,14 @@ impl Path {
                 });
                 eq_ok
                     && crate::piece::guard_kinds(cl).iter().all(|&kind| {
-                        let f = c.guard_form(Guard { node: i, kind });
-                        f.eval(lam, d) >= -tol.of(&f)
+                        let g = Guard { node: i, kind };
+                        let f = c.guard_form(g);
+                        let t = if c.label_only(g) {
+                            tol.label_of(&f)
+                        } else {
+                            tol.of(&f)
+                        };
+                        f.eval(lam, d) >= -t
                     })
             })
             .collect()
@@ -246,7 +252,12 @@ impl Path {
         } else {
             tol
         };
-        if !tol_row.at_zero(&form, v, vd) {
+        let at_zero = if self.consts().label_only(row.guard) {
+            tol_row.at_zero_label(&form, v, vd)
+        } else {
+            tol_row.at_zero(&form, v, vd)
+        };
+        if !at_zero {
             return if v > 0.0 { None } else { Some(false) };
         }
         let ts = tol.slope();
@@ -274,9 +285,30 @@ impl Path {
         out: &mut Vec<Candidate>,
         blockers: &mut Vec<usize>,
     ) {
+        // A frictionless node (F = 0) in contact slips: stick's region (F λν < λt < −F λν)
+        // is empty, and S+ and S− have the same equations (dν = 0, λt = 0), so the sign
+        // of its dt, not an enumeration, tells them apart (see `flips` below).
+        let consts = self.consts();
+        let frictionless = |i: usize| consts.friction[i] == 0.0;
+        let normalised: Vec<Class> = classes
+            .iter()
+            .enumerate()
+            .map(|(i, &cl)| {
+                if cl == Class::Stick && frictionless(i) {
+                    Class::SlipPlus
+                } else {
+                    cl
+                }
+            })
+            .collect();
+        let classes = &normalised[..];
+        let can_flip = classes
+            .iter()
+            .enumerate()
+            .any(|(i, &cl)| matches!(cl, Class::SlipPlus | Class::SlipMinus) && frictionless(i));
         // The piece the path came from cannot continue it: its crossing guard decreases
         // forward, and backward is where the path came from.
-        if back.is_some_and(|(bc, _)| bc == classes) {
+        if !can_flip && back.is_some_and(|(bc, _)| bc == classes) {
             return;
         }
         let tol_switching = tol.clone().approximate();
@@ -298,15 +330,37 @@ impl Path {
         let xp = xp.map(Arc::new);
         for s in [1.0, -1.0] {
             let ts: Vec<f64> = t.iter().map(|v| s * v).collect();
-            if out.iter().any(|c| {
-                c.classes == classes && c.t.iter().zip(&ts).map(|(a, b)| a * b).sum::<f64>() > 0.0
-            }) {
-                continue;
-            }
             let blocks = |row: &GuardRow| -> Option<bool> {
                 self.guard_blocks(row, s, (tol, &tol_switching), switching, relaxed)
             };
-            let enters = table.iter().all(|row| blocks(row).is_none());
+            // A frictionless node whose dt is at zero and decreases beyond its slope
+            // threshold along this way slips the other way: the same piece, the other sign.
+            // (Its S+ and S− entered a point where dt stays at zero, as on a symmetric
+            // body's axis, as two continuations, a bifurcation that was none; and tens of
+            // such nodes at once, where the tangential load turns, were 3^k pieces.)
+            let flips = |row: &GuardRow| {
+                consts.label_only(row.guard)
+                    && blocks(row) == Some(true)
+                    && s * row.slope < -tol.slope()
+            };
+            let mut classes_s = classes.to_vec();
+            for row in table.iter().filter(|row| flips(row)) {
+                let cl = &mut classes_s[row.guard.node];
+                *cl = if *cl == Class::SlipPlus {
+                    Class::SlipMinus
+                } else {
+                    Class::SlipPlus
+                };
+            }
+            if back.is_some_and(|(bc, _)| bc == classes_s)
+                || out.iter().any(|c| {
+                    c.classes == classes_s
+                        && c.t.iter().zip(&ts).map(|(a, b)| a * b).sum::<f64>() > 0.0
+                })
+            {
+                continue;
+            }
+            let enters = table.iter().all(|row| flips(row) || blocks(row).is_none());
             if !enters {
                 // Nodes not switching whose guard is at zero and leaves: see `transit`.
                 blockers.extend(
@@ -320,7 +374,7 @@ impl Path {
             }
             if enters {
                 out.push(Candidate::along(
-                    classes,
+                    &classes_s,
                     s,
                     (&lu, lu_orientation, scales),
                     (&t, &rate),
@@ -369,6 +423,29 @@ impl Path {
             )));
         }
         let is_vertex: Vec<bool> = options.iter().map(|o| o.len() == 4).collect();
+        // A frictionless node in contact is enumerated as one slip class, its sign read off
+        // its dt by `push_candidates` (the class it had where it fits, else S+).
+        let friction = self.consts().friction;
+        let options: Vec<Vec<Class>> = options
+            .into_iter()
+            .zip(nodes)
+            .map(|(o, &i)| {
+                let slips = [Class::SlipPlus, Class::SlipMinus];
+                if friction[i] != 0.0 || !o.iter().any(|c| slips.contains(c)) {
+                    return o;
+                }
+                let keep = if o.contains(&fixed[i]) && slips.contains(&fixed[i]) {
+                    fixed[i]
+                } else if o.contains(&Class::SlipPlus) {
+                    Class::SlipPlus
+                } else {
+                    Class::SlipMinus
+                };
+                o.into_iter()
+                    .filter(|&c| c == Class::Open || c == keep)
+                    .collect()
+            })
+            .collect();
         // Every neighbouring piece is examined while they are few enough (this finds every
         // directional solution at a zero-force vertex, hence every branch); beyond that,
         // the nodes at the vertex take their classes from the directional problem (one

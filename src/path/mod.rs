@@ -658,6 +658,24 @@ impl Tol {
                     && a <= self.rounding * self.of(f)))
     }
 
+    /// [`Self::at_zero`] for the slip guard of a frictionless node ([`PieceConstants::label_only`])
+    /// against [`Self::label_of`].
+    fn at_zero_label(&self, f: &crate::piece::LinForm, v: f64, vd: f64) -> bool {
+        let a = v.abs();
+        a.is_finite()
+            && ((vd.is_finite() && a <= self.arc * vd.abs())
+                || a <= self.rounding * self.label_of(f))
+    }
+
+    /// The threshold of a frictionless node's slip guard (its dt): [`Self::upper`], with
+    /// row k's terms bounded by `(|W| 1)_k ‖λ‖∞`. A dt that vanishes by symmetry or
+    /// because its neighbours stick (the node on a symmetric body's axis) is the rounding
+    /// of W's entries against all of λ: with its own row's terms (those entries' rounding
+    /// too) the threshold was a hundredth of it. The guard's side only names the class.
+    fn label_of(&self, f: &crate::piece::LinForm) -> f64 {
+        self.upper(f)
+    }
+
     /// `a ≤` [`Self::of`]`(f)`, its O(1) bound [`Self::upper`] tested first (`of` may cost
     /// a pass over a row of W). False for a NaN `a`.
     fn within(&self, f: &crate::piece::LinForm, a: f64) -> bool {
