@@ -658,8 +658,8 @@ impl Tol {
                     && a <= self.rounding * self.of(f)))
     }
 
-    /// [`Self::at_zero`] for the slip guard of a frictionless node ([`PieceConstants::label_only`])
-    /// against [`Self::label_of`].
+    /// [`Self::at_zero`] for the slip guard of a frictionless node
+    /// ([`PieceConstants::label_only`]), against [`Self::label_of`].
     fn at_zero_label(&self, f: &crate::piece::LinForm, v: f64, vd: f64) -> bool {
         let a = v.abs();
         a.is_finite()
