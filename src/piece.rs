@@ -142,11 +142,16 @@ impl<'a> PieceConstants<'a> {
         }
     }
 
-    /// Whether `g` is the slip guard (dt's sign) of a frictionless node (F = 0): its S+ and
-    /// S− have the same equations (dν = 0, λt = 0), so the guard's side names the class
-    /// and constrains nothing.
+    /// Whether node `i` is frictionless (F = 0): its stick region is empty, and its S+ and
+    /// S− have the same equations (dν = 0, λt = 0).
+    pub fn frictionless(&self, i: usize) -> bool {
+        self.friction[i] == 0.0
+    }
+
+    /// Whether `g` is the slip guard (dt's sign) of a [frictionless](Self::frictionless)
+    /// node: the guard's side names the class and constrains nothing.
     pub fn label_only(&self, g: Guard) -> bool {
-        matches!(g.kind, GuardKind::SlipPos | GuardKind::SlipNeg) && self.friction[g.node] == 0.0
+        matches!(g.kind, GuardKind::SlipPos | GuardKind::SlipNeg) && self.frictionless(g.node)
     }
 
     /// The guard as a linear form in force units.

@@ -289,12 +289,11 @@ impl Path {
         // is empty, and S+ and S− have the same equations (dν = 0, λt = 0), so the sign
         // of its dt, not an enumeration, tells them apart (see `flips` below).
         let consts = self.consts();
-        let frictionless = |i: usize| consts.friction[i] == 0.0;
         let normalised: Vec<Class> = classes
             .iter()
             .enumerate()
             .map(|(i, &cl)| {
-                if cl == Class::Stick && frictionless(i) {
+                if cl == Class::Stick && consts.frictionless(i) {
                     Class::SlipPlus
                 } else {
                     cl
@@ -302,10 +301,9 @@ impl Path {
             })
             .collect();
         let classes = &normalised[..];
-        let can_flip = classes
-            .iter()
-            .enumerate()
-            .any(|(i, &cl)| matches!(cl, Class::SlipPlus | Class::SlipMinus) && frictionless(i));
+        let can_flip = classes.iter().enumerate().any(|(i, &cl)| {
+            matches!(cl, Class::SlipPlus | Class::SlipMinus) && consts.frictionless(i)
+        });
         // The piece the path came from cannot continue it: its crossing guard decreases
         // forward, and backward is where the path came from.
         if !can_flip && back.is_some_and(|(bc, _)| bc == classes) {
@@ -338,13 +336,16 @@ impl Path {
             // (Its S+ and S− entered a point where dt stays at zero, as on a symmetric
             // body's axis, as two continuations, a bifurcation that was none; and tens of
             // such nodes at once, where the tangential load turns, were 3^k pieces.)
-            let flips = |row: &GuardRow| {
-                consts.label_only(row.guard)
-                    && blocks(row) == Some(true)
-                    && s * row.slope < -tol.slope()
-            };
+            let flips: Vec<bool> = table
+                .iter()
+                .map(|row| {
+                    consts.label_only(row.guard)
+                        && blocks(row) == Some(true)
+                        && s * row.slope < -tol.slope()
+                })
+                .collect();
             let mut classes_s = classes.to_vec();
-            for row in table.iter().filter(|row| flips(row)) {
+            for (row, _) in table.iter().zip(&flips).filter(|(_, f)| **f) {
                 let cl = &mut classes_s[row.guard.node];
                 *cl = if *cl == Class::SlipPlus {
                     Class::SlipMinus
@@ -360,7 +361,10 @@ impl Path {
             {
                 continue;
             }
-            let enters = table.iter().all(|row| flips(row) || blocks(row).is_none());
+            let enters = table
+                .iter()
+                .zip(&flips)
+                .all(|(row, &flip)| flip || blocks(row).is_none());
             if !enters {
                 // Nodes not switching whose guard is at zero and leaves: see `transit`.
                 blockers.extend(
@@ -425,13 +429,13 @@ impl Path {
         let is_vertex: Vec<bool> = options.iter().map(|o| o.len() == 4).collect();
         // A frictionless node in contact is enumerated as one slip class, its sign read off
         // its dt by `push_candidates` (the class it had where it fits, else S+).
-        let friction = self.consts().friction;
+        let consts = self.consts();
         let options: Vec<Vec<Class>> = options
             .into_iter()
             .zip(nodes)
             .map(|(o, &i)| {
                 let slips = [Class::SlipPlus, Class::SlipMinus];
-                if friction[i] != 0.0 || !o.iter().any(|c| slips.contains(c)) {
+                if !consts.frictionless(i) || !o.iter().any(|c| slips.contains(c)) {
                     return o;
                 }
                 let keep = if o.contains(&fixed[i]) && slips.contains(&fixed[i]) {
