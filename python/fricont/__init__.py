@@ -135,7 +135,17 @@ def _csr(name: str, m: Any, shape: Optional[Tuple[int, int]] = None):
 
 
 def _vector(name: str, v: Any) -> np.ndarray:
-    return np.ascontiguousarray(_float64(name, v).ravel())
+    """``v`` as a contiguous 1-D float64 array. A row or column (shape ``(1, n)``, ``(n, 1)``)
+    is taken as the vector it is; an array with two or more axes longer than one (a
+    ``(nodes, 2)`` table of nodal values, say) is a ValueError: which order its entries take
+    in the dofs of A is the caller's to say (``.ravel()`` it in that order)."""
+    a = _float64(name, v)
+    if sum(1 for d in a.shape if d != 1) > 1:
+        raise ValueError(
+            f"{name}: expected a vector, got an array of shape {a.shape}; flatten it in the "
+            "order of the dofs of A (e.g. .ravel()) if that is what it holds"
+        )
+    return np.ascontiguousarray(a.ravel())
 
 
 @dataclass(frozen=True)
@@ -320,10 +330,17 @@ class Path:
     def event_state(self, k: int) -> dict:
         """The full state at event k (0-based): ``u`` (n), ``lambda_n``, ``lambda_t`` (p),
         ``classes`` (after the event), ``residual``, ``alpha``. One back-solve with the
-        Cholesky factor of A; the GIL is released meanwhile. Errors: IndexError-like
-        :class:`UsageError` for k out of range."""
+        Cholesky factor of A; the GIL is released meanwhile. A negative k counts from the
+        last event, as a list index does (``-1``: the last). Errors: ValueError when k is not
+        an integer; :class:`UsageError` for k out of range."""
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+            raise ValueError(f"k = {k!r}: expected an event index, an integer")
+        count = len(self.events)
+        i = int(k) + count if k < 0 else int(k)
+        if not 0 <= i < count:
+            raise UsageError(f"event index {int(k)} is out of range: the path has {count} events")
         try:
-            return self._core.event_state(int(k))
+            return self._core.event_state(i)
         except Exception as err:  # noqa: BLE001
             raise _reraise(err) from None
 
@@ -399,14 +416,14 @@ class Problem:
         n = _csr("N", N)
         t = _csr("T", T)
         p = n[0][0]
-        fr = _float64("friction", friction).ravel()
+        fr = _vector("friction", friction)
         if fr.size == 1:
             fr_list = [float(fr[0])]
         else:
             fr_list = [float(x) for x in fr]
             if len(fr_list) != p:
                 raise ValueError(f"friction has {len(fr_list)} values, expected 1 or p = {p}")
-        g = None if gap is None else [float(x) for x in _float64("gap", gap).ravel()]
+        g = None if gap is None else [float(x) for x in _vector("gap", gap)]
         try:
             if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
                 raise ValueError(f"threads = {threads!r}: expected an integer in 1..1024")

@@ -362,6 +362,34 @@ def test_bad_inputs_raise_the_documented_exceptions(sample):
         fricont.read_case(SAMPLE / "missing")
 
 
+def test_vectors_and_event_indices_are_taken_as_meant(sample):
+    # A (nodes, 2) table is not a vector: which dof each entry is belongs to the caller.
+    # A column, and a list index counted from the end, are what they say.
+    prob = fricont.Problem(sample["A"], sample["N"], sample["T"], friction=sample["friction"])
+    f0, f1, win = sample["f0"], sample["f1"], (sample["alpha_start"], sample["alpha_end"])
+    ref = prob.trace(f0, f1, window=win)
+    assert len(ref.events) >= 2
+    with pytest.raises(ValueError, match=r"f0: expected a vector, got an array of shape \(660, 2\)"):
+        prob.trace(f0.reshape(-1, 2), f1, window=win)
+    with pytest.raises(ValueError, match="shape"):
+        prob.trace(load=lambda a: (f0 + a * f1).reshape(-1, 2), window=win)
+    with pytest.raises(ValueError, match="friction: expected a vector"):
+        fricont.Problem(sample["A"], sample["N"], sample["T"], friction=np.full((2, 15), 0.3))
+    assert same_path(prob.trace(f0.reshape(-1, 1), f1.reshape(1, -1), window=win), ref)
+    count = len(ref.events)
+    last = ref.event_state(count - 1)
+    for k in (-1, np.int64(-1)):
+        st = ref.event_state(k)
+        assert st["alpha"] == last["alpha"] and np.array_equal(st["u"], last["u"])
+    assert ref.event_state(-count)["alpha"] == ref.event_state(0)["alpha"]
+    for k in (count, -count - 1):
+        with pytest.raises(fricont.UsageError, match="out of range"):
+            ref.event_state(k)
+    for k in (1.0, True, "0"):
+        with pytest.raises(ValueError, match="event index"):
+            ref.event_state(k)
+
+
 def test_the_skfem_example_agrees_with_the_cli(tmp_path):
     proc = subprocess.run([sys.executable, str(EXAMPLES / "skfem_block.py"), str(tmp_path), "--export"],
                           check=True, capture_output=True, text=True)
