@@ -1349,7 +1349,10 @@ fricont_status fricont_path_set_max_steps(struct fricont_path *path,
 /**
  * Sets the relative tolerance for "a guard is at zero" and "several nodes switch at
  * once" (dimensionless, relative to the force scale of the current point). Default 1e-11;
- * must be in (0, 1e-3]. Only before the first start.
+ * must be in (0, 1e-3]. Only before the first start. Friction below about `zero_tol`
+ * times the forces is not resolved: where such a node's slip reverses while it is
+ * pressed, the run fails with `FRICONT_ERR_NUMERICAL` ("without the stick phase"; F =
+ * 1e-10 traces with 1e-12). Give frictionless nodes F = 0.
  *
  * Returns `FRICONT_OK`, `FRICONT_ERR_NULL`, `FRICONT_ERR_RANGE`, `FRICONT_ERR_ORDER`
  * (after the first start), `FRICONT_ERR_POISONED`, `FRICONT_ERR_PANIC`.

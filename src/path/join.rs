@@ -39,6 +39,14 @@ const NEAR_VANISHING: f64 = 1e-6;
 /// (see [`Path::directional_classes`]) before it is solved from zero forces.
 const NEAR_NEWTON_ITERATIONS: usize = 20;
 
+/// How far from zero (times its threshold) a node's normal force must be for a change
+/// between its slip classes to be an unresolved stick phase ([`Path::unresolved_cone`]).
+/// Both slip classes fit only where `2 F |λν|` is within the force threshold, so at this
+/// factor only nodes with F below about 1e-3 can trip it; a node whose normal force is
+/// nearer zero passes between slip classes through a point where every force of it is at
+/// zero.
+const UNRESOLVED_CONE: f64 = 1e3;
+
 #[cfg(test)]
 thread_local! {
     /// Test switch: every directional solve of the enumeration's first pass fails, as
@@ -1406,9 +1414,64 @@ impl Path {
         Ok(pt)
     }
 
-    /// Moves onto candidate `k` of a pending transition and records its events.
+    /// An error where `classes` take a node with F > 0 from one slip class straight to the
+    /// other while its normal force is far from zero ([`UNRESOLVED_CONE`] times its
+    /// threshold). Between slip− and slip+ such a node sticks while λt crosses its cone,
+    /// a change of 2 F |λν|. That both slip classes fit it at one point means F |λν| is
+    /// within the threshold of the forces: its friction is too small for `zero_tol` to
+    /// resolve (`tests/core_small_friction.rs`: with F = 1e-10, traces went on past such
+    /// events to the window, every state solving the problem to 1e-6, where the reference
+    /// tracer finds a stick phase about 1e-10 of α long).
+    fn unresolved_cone(&self, pend: &PendingJoin, classes: &[Class]) -> Result<()> {
+        use Class::{SlipMinus, SlipPlus};
+        if pend.at_start {
+            // the branches leaving the start record no events
+            return Ok(());
+        }
+        let friction = self.problem.friction_equilibrated();
+        let Some(i) = (0..classes.len()).find(|&i| {
+            friction[i] > 0.0
+                && matches!(
+                    (pend.from[i], classes[i]),
+                    (SlipMinus, SlipPlus) | (SlipPlus, SlipMinus)
+                )
+        }) else {
+            return Ok(());
+        };
+        let pt = &pend.point;
+        let thr = self.tol_at(pt).of(&self.consts().guard_form(Guard {
+            node: i,
+            kind: crate::piece::GuardKind::Compress,
+        }));
+        let lam_n = pt.lam[i].abs();
+        if lam_n <= UNRESOLVED_CONE * thr {
+            return Ok(());
+        }
+        let scale = self.force_scale(pt);
+        Err(Error::Numerical(format!(
+            "node {} changes from {} to {} at alpha = {:e} without the stick phase between them: \
+             its friction coefficient F = {:e} ({:e} on its equilibrated rows) times its normal \
+             force is {:.1e} of the contact forces' scale, within zero_tol = {:e} of it, while \
+             the normal force is {:.1e} of that scale. Stick, slip+ and slip- all fit the node \
+             there, and the stick phase is not resolved: a node with this little friction is \
+             frictionless at this zero_tol. Give it F = 0, or trace with a smaller zero_tol",
+            i + 1,
+            pend.from[i],
+            classes[i],
+            pt.alpha,
+            self.problem.friction()[i],
+            friction[i],
+            friction[i] * lam_n / scale,
+            self.opts.zero_tol,
+            lam_n / scale,
+        )))
+    }
+
+    /// Moves onto candidate `k` of a pending transition and records its events. Errors:
+    /// see [`Self::unresolved_cone`].
     pub(super) fn apply(&mut self, pend: &PendingJoin, k: usize) -> Result<StepOutcome> {
         let cand = pend.cands[k].clone();
+        self.unresolved_cone(pend, &cand.classes)?;
         self.commit_solver(&cand.lu);
         let mut pt = pend.point.clone();
         self.consts()

@@ -45,7 +45,10 @@ pub struct PathOptions {
     /// (default 1e-11). It is relative to local scales of the current point, never to
     /// the window: a force guard to the contact forces there, a displacement guard
     /// (compared after multiplication by [`Problem::default_r`]) to the magnitude of the
-    /// terms of its own row of `q + W λ − (g, 0)`.
+    /// terms of its own row of `q + W λ − (g, 0)`. A node's friction below about
+    /// `zero_tol` times the forces is not resolved: where such a node's slip reverses
+    /// while it is pressed, the run stops with [`Error::Numerical`] ("without the stick
+    /// phase"; F = 1e-10 traced with 1e-12). Give frictionless nodes F = 0.
     pub zero_tol: f64,
     /// Factorise every piece matrix afresh (O(m³) per piece, m = 2p) instead of updating
     /// one factorised base by rank-2 changes (O(m²) per piece; default `false`). The
