@@ -41,10 +41,10 @@ const NEAR_NEWTON_ITERATIONS: usize = 20;
 
 /// How far from zero (times its threshold) a node's normal force must be for a change
 /// between its slip classes to be an unresolved stick phase ([`Path::unresolved_cone`]).
-/// Both slip classes fit only where `2 F |λν|` is within the force threshold, so at this
-/// factor only nodes with F below about 1e-3 can trip it; a node whose normal force is
-/// nearer zero passes between slip classes through a point where every force of it is at
-/// zero.
+/// Both slip classes fit only where `2 F |λν|` is within the force threshold (at most
+/// [`MAX_WIDENING`] times the usual one), so at this factor only nodes with F below about
+/// 0.06 can trip it; a node whose normal force is nearer zero passes between slip classes
+/// through a point where every force of it is at zero.
 const UNRESOLVED_CONE: f64 = 1e3;
 
 #[cfg(test)]
@@ -1228,10 +1228,11 @@ impl Path {
                 return Err(e);
             }
             return Err(Error::Numerical(format!(
-                "no neighbouring piece continues the path at alpha = {:e} (nodes {:?}){}",
+                "no neighbouring piece continues the path at alpha = {:e} (nodes {:?}){}{}",
                 pt.alpha,
                 nodes.iter().map(|i| i + 1).collect::<Vec<_>>(),
-                near_overflow(&pt)
+                near_overflow(&pt),
+                self.unresolved_friction_hint(&pt, &nodes)
             )));
         }
         let bifurcation = cands.len() > 1;
@@ -1439,14 +1440,9 @@ impl Path {
             return Ok(());
         };
         let pt = &pend.point;
-        let thr = self.tol_at(pt).of(&self.consts().guard_form(Guard {
-            node: i,
-            kind: crate::piece::GuardKind::Compress,
-        }));
-        let lam_n = pt.lam[i].abs();
-        if lam_n <= UNRESOLVED_CONE * thr {
+        let Some(lam_n) = self.unresolved_friction(pt, i) else {
             return Ok(());
-        }
+        };
         let scale = self.force_scale(pt);
         Err(Error::Numerical(format!(
             "node {} changes from {} to {} at alpha = {:e} without the stick phase between them: \
@@ -1465,6 +1461,40 @@ impl Path {
             self.opts.zero_tol,
             lam_n / scale,
         )))
+    }
+
+    /// Node i's |λν| at `pt` where its friction is not resolved there: F > 0, F |λν|
+    /// within the widest retry's force threshold, and |λν| above [`UNRESOLVED_CONE`] times
+    /// it (a node whose normal force is at zero has no friction to resolve). None else.
+    fn unresolved_friction(&self, pt: &Point, i: usize) -> Option<f64> {
+        let f = self.problem.friction_equilibrated()[i];
+        if f == 0.0 {
+            return None;
+        }
+        let thr = self.tol_at(pt).of(&self.consts().guard_form(Guard {
+            node: i,
+            kind: crate::piece::GuardKind::Compress,
+        }));
+        let lam_n = pt.lam[i].abs();
+        (lam_n > UNRESOLVED_CONE * thr && f * lam_n <= MAX_WIDENING * thr).then_some(lam_n)
+    }
+
+    /// For an error at `pt` among `nodes`: a sentence naming the first node whose friction
+    /// is not resolved there ([`Self::unresolved_friction`]), else "".
+    fn unresolved_friction_hint(&self, pt: &Point, nodes: &[usize]) -> String {
+        nodes
+            .iter()
+            .find(|&&i| self.unresolved_friction(pt, i).is_some())
+            .map_or(String::new(), |&i| {
+                format!(
+                    "; node {}'s friction coefficient F = {:e} times its normal force is within \
+                     the thresholds of the forces there (zero_tol = {:e}), so its stick \
+                     phases are not resolved: give it F = 0, or trace with a smaller zero_tol",
+                    i + 1,
+                    self.problem.friction()[i],
+                    self.opts.zero_tol
+                )
+            })
     }
 
     /// Moves onto candidate `k` of a pending transition and records its events. Errors:
