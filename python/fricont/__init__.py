@@ -573,7 +573,10 @@ class Problem:
         ``zero_tol`` (default 1e-11, in (0, 1e-3]): the relative tolerance for "a guard is
         at zero" and "two nodes switch at once", relative to the local scales of each point
         (the contact forces there, the terms of a displacement's own row), never to the
-        window. ValueError outside that range.
+        window. ValueError outside that range. A friction coefficient so small that F times
+        a node's normal force is within it is not resolved: where such a node's slip
+        reverses while pressed, the path stops with an :class:`Error` that names the node
+        (give it F = 0, or a smaller ``zero_tol``: F = 1e-10 traces with 1e-12).
 
         The GIL is released while tracing (re-acquired only to call ``load``, ``dload`` or
         ``monitor``), so threads can trace different problems at once.
