@@ -335,10 +335,14 @@ class Path:
         an integer; :class:`UsageError` for k out of range."""
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
             raise ValueError(f"k = {k!r}: expected an event index, an integer")
-        count = len(self.events)
-        i = int(k) + count if k < 0 else int(k)
-        if not 0 <= i < count:
-            raise UsageError(f"event index {int(k)} is out of range: the path has {count} events")
+        # A negative k counts from the end of `self.events`; the library checks the range
+        # (and refuses a call from inside the path's own monitor, where `self.events` is
+        # not yet refreshed).
+        i = int(k)
+        if i < 0:
+            i += len(self.events)
+            if i < 0:
+                raise UsageError(f"event {int(k)} does not exist ({len(self.events)} events)")
         try:
             return self._core.event_state(i)
         except Exception as err:  # noqa: BLE001
