@@ -1429,20 +1429,18 @@ impl Path {
             // the branches leaving the start record no events
             return Ok(());
         }
-        let friction = self.problem.friction_equilibrated();
-        let Some(i) = (0..classes.len()).find(|&i| {
-            friction[i] > 0.0
-                && matches!(
-                    (pend.from[i], classes[i]),
-                    (SlipMinus, SlipPlus) | (SlipPlus, SlipMinus)
-                )
+        let pt = &pend.point;
+        let Some((i, lam_n)) = (0..classes.len()).find_map(|i| {
+            matches!(
+                (pend.from[i], classes[i]),
+                (SlipMinus, SlipPlus) | (SlipPlus, SlipMinus)
+            )
+            .then(|| self.unresolved_friction(pt, i).map(|l| (i, l)))
+            .flatten()
         }) else {
             return Ok(());
         };
-        let pt = &pend.point;
-        let Some(lam_n) = self.unresolved_friction(pt, i) else {
-            return Ok(());
-        };
+        let friction = self.problem.friction_equilibrated();
         let scale = self.force_scale(pt);
         Err(Error::Numerical(format!(
             "node {} changes from {} to {} at alpha = {:e} without the stick phase between them: \
