@@ -1440,7 +1440,7 @@ impl Path {
         }) else {
             return Ok(());
         };
-        let friction = self.problem.friction_equilibrated();
+        let friction = self.consts().friction;
         let scale = self.force_scale(pt);
         Err(Error::Numerical(format!(
             "node {} changes from {} to {} at alpha = {:e} without the stick phase between them: \
@@ -1465,11 +1465,12 @@ impl Path {
     /// within the widest retry's force threshold, and |λν| above [`UNRESOLVED_CONE`] times
     /// it (a node whose normal force is at zero has no friction to resolve). None else.
     fn unresolved_friction(&self, pt: &Point, i: usize) -> Option<f64> {
-        let f = self.problem.friction_equilibrated()[i];
-        if f == 0.0 {
+        let c = self.consts();
+        if c.frictionless(i) {
             return None;
         }
-        let thr = self.tol_at(pt).of(&self.consts().guard_form(Guard {
+        let f = c.friction[i];
+        let thr = self.tol_at(pt).of(&c.guard_form(Guard {
             node: i,
             kind: crate::piece::GuardKind::Compress,
         }));
