@@ -100,6 +100,19 @@ fn rel_residual(c: &PieceConstants, qg: &[f64], lam: &[f64], d: &[f64], fr: Froz
     (0..p).fold(0.0f64, |m, i| m.max(h[i].abs().max(h[p + i].abs()) / s[i]))
 }
 
+/// [`rel_residual`] of `λ` for `q − (g, 0)` = `qg` with the classes of `fr` imposed, as
+/// the solver's stages measure it (one product with W).
+pub(crate) fn residual_of(
+    problem: &crate::problem::Problem,
+    qg: &[f64],
+    lam: &[f64],
+    fr: Frozen<'_>,
+) -> f64 {
+    let c = PieceConstants::of(problem);
+    let d = displacement_gaps(problem.delassus().w(), qg, lam);
+    rel_residual(&c, qg, lam, &d, fr)
+}
+
 fn merit(c: &PieceConstants, qg: &[f64], lam: &[f64], d: &[f64], fr: Frozen<'_>) -> f64 {
     let (h, _) = h_condensed(c, qg, lam, d, fr);
     0.5 * h.iter().map(|v| v * v).sum::<f64>()

@@ -483,19 +483,28 @@ impl Path {
         let pivoting = enumerated.iter().all(|&k| options[k].len() <= 2);
         if combos > limit && pivoting {
             let mut out = Vec::new();
-            for want in [1.0, -1.0] {
-                let Some(cl) = self.pivoted_classes(
-                    pt,
-                    fixed,
-                    (nodes, &options, &is_vertex),
-                    (want, relaxed),
-                    &tol,
-                ) else {
-                    continue;
-                };
-                self.push_candidates(
-                    &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
-                );
+            // First with the directional problem's stalled solves taken where close (see
+            // `DIRECTIONAL_LOOSE`), then, where that took one and found nothing, without.
+            for loose in [true, false] {
+                let took = Cell::new(false);
+                for want in [1.0, -1.0] {
+                    let Some(cl) = self.pivoted_classes(
+                        pt,
+                        fixed,
+                        (nodes, &options, &is_vertex),
+                        (want, relaxed),
+                        &tol,
+                        loose.then_some(&took),
+                    ) else {
+                        continue;
+                    };
+                    self.push_candidates(
+                        &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
+                    );
+                }
+                if !out.is_empty() || !took.get() {
+                    break;
+                }
             }
             // (none: the relaxed slopes of `continuations_either` may find one; or the
             // enumeration below, where the combinations are few enough for it)
@@ -541,7 +550,7 @@ impl Path {
                         .map(|(&c, &f)| (!f).then_some(c))
                         .collect();
                     for s in [1.0, -1.0] {
-                        match self.directional_classes(pt, &frozen, s, quick) {
+                        match self.directional_classes(pt, &frozen, s, quick, None) {
                             Ok(cl) => self.push_candidates(
                                 &cl, pt, scale, &tol, nodes, back, relaxed, &mut out, blockers,
                             ),
@@ -599,6 +608,7 @@ impl Path {
         (nodes, options, vertex): (&[usize], &[Vec<Class>], &[bool]),
         (want, relaxed): (f64, bool),
         tol: &Tol,
+        loose: Option<&Cell<bool>>,
     ) -> Option<Vec<Class>> {
         let scale = self.force_scale(pt);
         let tol_switching = tol.clone().approximate();
@@ -620,7 +630,9 @@ impl Path {
                     .enumerate()
                     .map(|(i, &c)| (!slots[i].is_some_and(|k| vertex[k])).then_some(c))
                     .collect();
-                classes = self.directional_classes(pt, &frozen, want, false).ok()?;
+                classes = self
+                    .directional_classes(pt, &frozen, want, false, loose)
+                    .ok()?;
             }
             if !seen.insert(classes.clone()) {
                 return None;
@@ -685,13 +697,17 @@ impl Path {
     /// the contact problem for the derivatives, `ḋ = W λ̇ + s q'`, with the frozen nodes'
     /// equations. `Err(false)` where the solver finds no solution or a free node stays
     /// degenerate; with `quick`, `Err(true)` where the solver's first stages find none
-    /// (`solve::Stages::First`: the last ones may).
+    /// (`solve::Stages::First`: the last ones may). With `loose`, a stalled iterate of the
+    /// solver within [`DIRECTIONAL_LOOSE`] is taken as the solution, and `loose` is set
+    /// when one was (the caller checks the classes on their piece, and solves again
+    /// without where that finds no continuation).
     pub(super) fn directional_classes(
         &self,
         pt: &Point,
         frozen: &[Option<Class>],
         s: f64,
         quick: bool,
+        loose: Option<&Cell<bool>>,
     ) -> std::result::Result<Vec<Class>, bool> {
         #[cfg(test)]
         if let Some(n) = FIRST_PASS_REFUSES.get().filter(|_| quick) {
@@ -724,17 +740,29 @@ impl Path {
             )
         }) {
             Some(solved) => solved,
-            None => solve_with_frozen(
-                &self.problem,
-                &qdir,
-                None,
-                pt.alpha,
-                Some(frozen),
-                if quick { Stages::First } else { Stages::All },
-                self.updater.borrow().clone(),
-                None,
-            )
-            .map_err(|_| quick)?,
+            None => {
+                let mut take = |lam: &[f64]| -> Option<Vec<f64>> {
+                    let cell = loose?;
+                    let r = crate::solve::residual_of(&self.problem, &qdir, lam, Some(frozen));
+                    (r <= DIRECTIONAL_LOOSE).then(|| {
+                        cell.set(true);
+                        lam.to_vec()
+                    })
+                };
+                solve_with_frozen(
+                    &self.problem,
+                    &qdir,
+                    None,
+                    pt.alpha,
+                    Some(frozen),
+                    if quick { Stages::First } else { Stages::All },
+                    self.updater.borrow().clone(),
+                    loose
+                        .is_some()
+                        .then_some(&mut take as &mut dyn FnMut(&[f64]) -> _),
+                )
+                .map_err(|_| quick)?
+            }
         };
         {
             let mut warm = self.directional_warm.borrow_mut();

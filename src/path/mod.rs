@@ -1007,6 +1007,15 @@ const MAX_CANDIDATE_PIECES: usize = 4096;
 /// combination up to [`MAX_CANDIDATE_PIECES`] is enumerated as before.
 const MAX_DIRECTIONAL_COMBINATIONS: usize = 64;
 
+/// Relative residual (as the fixed-α solver measures it) below which a stalled solve of
+/// the directional problem is taken while pivoting on many nodes' classes
+/// ([`Path::directional_classes`]): its classes are only a candidate's, which its piece's
+/// tangent, from the data, then checks. On the p = 2000 strip of `fricont gen-rect
+/// --press-shear --nx 2001 --ny 76 --lx 20 --ly 0.76` Newton stalled there at residuals of
+/// 1e-10 to 2e-8, where the solver's later stages took 0.3–2 s each and, once, 143 s
+/// (20,000 Gauss–Seidel sweeps).
+const DIRECTIONAL_LOOSE: f64 = 1e-7;
+
 impl Path {
     /// Binds a load to a problem. Computes the condensed load vectors (one back-solve per
     /// basis vector). Errors: load length ≠ n; window bounds not finite or equal;
