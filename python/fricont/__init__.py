@@ -134,6 +134,11 @@ def _csr(name: str, m: Any, shape: Optional[Tuple[int, int]] = None):
     )
 
 
+def _is_int(x: Any) -> bool:
+    """Whether ``x`` is an integer (Python or NumPy), and not a bool."""
+    return isinstance(x, (int, np.integer)) and not isinstance(x, bool)
+
+
 def _vector(name: str, v: Any) -> np.ndarray:
     """``v`` as a contiguous 1-D float64 array. A row or column (shape ``(1, n)``, ``(n, 1)``)
     is taken as the vector it is; an array with two or more axes longer than one (a
@@ -320,7 +325,7 @@ class Path:
         or ``k`` is out of range, with this path as ``err.path``; otherwise as
         :meth:`resume`.
         """
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 0:
+        if not _is_int(k) or k < 0:
             raise ValueError(f"k = {k!r}: expected a branch index, an integer >= 0")
         self._core.choose_branch(int(k), monitor)
         self._refresh()
@@ -333,7 +338,7 @@ class Path:
         Cholesky factor of A; the GIL is released meanwhile. A negative k counts from the
         last event, as a list index does (``-1``: the last). Errors: ValueError when k is not
         an integer; :class:`UsageError` for k out of range."""
-        if isinstance(k, bool) or not isinstance(k, (int, np.integer)):
+        if not _is_int(k):
             raise ValueError(f"k = {k!r}: expected an event index, an integer")
         # A negative k counts from the end of `self.events`; the library checks the range
         # (and refuses a call from inside the path's own monitor, where `self.events` is
@@ -429,7 +434,7 @@ class Problem:
                 raise ValueError(f"friction has {len(fr_list)} values, expected 1 or p = {p}")
         g = None if gap is None else [float(x) for x in _vector("gap", gap)]
         try:
-            if isinstance(threads, bool) or not isinstance(threads, (int, np.integer)) or threads < 1:
+            if not _is_int(threads) or threads < 1:
                 raise ValueError(f"threads = {threads!r}: expected an integer in 1..1024")
             self._core = _core.Problem(
                 a, n, t, fr_list, g, None if r is None else float(r), storage, int(threads),
@@ -606,9 +611,7 @@ class Problem:
         zt = None if zero_tol is None else float(zero_tol)
         opts = (win, a0, ms, h, zt)
         g = None if guess is None else _vector("guess", guess)
-        if branch is not None and (
-            isinstance(branch, bool) or not isinstance(branch, (int, np.integer)) or branch < 0
-        ):
+        if branch is not None and (not _is_int(branch) or branch < 0):
             raise ValueError(f"branch = {branch!r}: expected None or an integer >= 0")
         b = None if branch is None else int(branch)
         if basis is not None or weights is not None:
